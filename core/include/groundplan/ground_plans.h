@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// The union stage: footprints in, non-overlapping ground plans out (paper §3, §5, §6).
+#include <groundplan/progress.h>
+#include <groundplan/types.h>
+#include <vector>
+
+namespace groundplan {
+
+enum class Device { Auto, Cpu, Cuda };
+
+struct UnionParams {
+  double resolution_m = 0;     // raster pixel for blocks/seeds; 0 = automatic (paper §5). Exactness never depends on it.
+  Device device = Device::Auto;
+  int threads = 0;             // 0 = all cores
+};
+
+/// The exact union of `footprints` (working CRS, metres), one GroundPlan per connected region.
+/// Output rings: outer CCW, holes CW, no repeated points, valid by OGC rules (GEOS isValid).
+/// Members list every footprint index that contributes area to the plan. A footprint with no
+/// usable area (all polygons degenerate) is reported in `problems` (stage "union") and is in no plan.
+/// Throws Cancelled if `progress` asks to stop.
+std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footprints, const UnionParams& params,
+                                           std::vector<Problem>& problems, const Progress& progress = {});
+
+}  // namespace groundplan
