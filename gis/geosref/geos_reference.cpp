@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: MIT
+// GEOS UnaryUnion as the correctness reference, through the stable C API (geos_c.h).
+#include <groundplan/error.h>
+#include <groundplan/gis/geos_reference.h>
+
+#include <geos_c.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+namespace groundplan::gis {
+namespace {
+
+void geos_message(const char* fmt, ...) {
+  // GEOS notices (e.g. "Self-intersection at ...") are expected on bad input; we report through results.
+  (void)fmt;
+}
+
+/// One GEOS context, destroyed with the object: calls from several threads each get their own.
+class Context {
+ public:
+  Context() : h_(GEOS_init_r()) {
+    GEOSContext_setNoticeHandler_r(h_, geos_message);
+    GEOSContext_setErrorHandler_r(h_, geos_message);
+  }
+  ~Context() { GEOS_finish_r(h_); }
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+  GEOSContextHandle_t get() const { return h_; }
+
+ private:
+  GEOSContextHandle_t h_;
+};
+
+struct GeomDeleter {
+  GEOSContextHandle_t h;
+  void operator()(GEOSGeometry* g) const {
+    if (g) GEOSGeom_destroy_r(h, g);
+  }
+};
+using GeomPtr = std::unique_ptr<GEOSGeometry, GeomDeleter>;
+
+GEOSGeometry* make_ring(GEOSContextHandle_t h, const Ring& ring) {
+  if (ring.size() < 3) return nullptr;
+  GEOSCoordSequence* seq = GEOSCoordSeq_create_r(h, static_cast<unsigned>(ring.size() + 1), 2);
+  for (std::size_t i = 0; i <= ring.size(); ++i) {
+    const Point2& p = ring[i % ring.size()];
+    GEOSCoordSeq_setXY_r(h, seq, static_cast<unsigned>(i), p.x, p.y);
+  }
+  return GEOSGeom_createLinearRing_r(h, seq);
+}
+
+/// A polygon as GEOS geometry; nullptr if the outer ring has fewer than 3 points.
+GEOSGeometry* make_polygon(GEOSContextHandle_t h, const Polygon& poly) {
+  GEOSGeometry* shell = make_ring(h, poly.outer);
+  if (!shell) return nullptr;
+  std::vector<GEOSGeometry*> holes;
+  for (const Ring& r : poly.holes)
+    if (GEOSGeometry* g = make_ring(h, r)) holes.push_back(g);
+  return GEOSGeom_createPolygon_r(h, shell, holes.data(), static_cast<unsigned>(holes.size()));
+}
+
+Ring ring_from(GEOSContextHandle_t h, const GEOSGeometry* ring) {
+  const GEOSCoordSequence* seq = GEOSGeom_getCoordSeq_r(h, ring);
+  unsigned n = 0;
+  GEOSCoordSeq_getSize_r(h, seq, &n);
+  Ring out;
+  out.reserve(n);
+  for (unsigned i = 0; i + 1 < n; ++i) {  // drop the closing vertex
+    Point2 p;
+    GEOSCoordSeq_getXY_r(h, seq, i, &p.x, &p.y);
+    out.push_back(p);
+  }
+  return out;
+}
+
+Polygon polygon_from(GEOSContextHandle_t h, const GEOSGeometry* g) {
+  Polygon p;
+  p.outer = ring_from(h, GEOSGetExteriorRing_r(h, g));
+  const int nh = GEOSGetNumInteriorRings_r(h, g);
+  for (int i = 0; i < nh; ++i) p.holes.push_back(ring_from(h, GEOSGetInteriorRingN_r(h, g, i)));
+  return p;
+}
+
+/// Polygonal parts of g (GeometryCollections from MakeValid may hold lines and points: dropped,
+/// they have no area).
+void collect_polygons(GEOSContextHandle_t h, const GEOSGeometry* g, std::vector<const GEOSGeometry*>& out) {
+  const int type = GEOSGeomTypeId_r(h, g);
+  if (type == GEOS_POLYGON) {
+    if (!GEOSisEmpty_r(h, g)) out.push_back(g);
+  } else if (type == GEOS_MULTIPOLYGON || type == GEOS_GEOMETRYCOLLECTION) {
+    const int n = GEOSGetNumGeometries_r(h, g);
+    for (int i = 0; i < n; ++i) collect_polygons(h, GEOSGetGeometryN_r(h, g, i), out);
+  }
+}
+
+/// The union of all footprint polygons as one GEOS geometry (owned).
+GeomPtr union_of(GEOSContextHandle_t h, const std::vector<Footprint>& footprints) {
+  std::vector<GEOSGeometry*> parts;
+  for (const Footprint& f : footprints) {
+    for (const Polygon& poly : f.polygons) {
+      GEOSGeometry* g = make_polygon(h, poly);
+      if (!g) continue;
+      if (GEOSisValid_r(h, g) != 1) {
+        GEOSGeometry* fixed = GEOSMakeValid_r(h, g);
+        GEOSGeom_destroy_r(h, g);
+        g = fixed;
+        if (!g) continue;
+      }
+      parts.push_back(g);
+    }
+  }
+  GeomPtr collection(GEOSGeom_createCollection_r(h, GEOS_GEOMETRYCOLLECTION, parts.data(),
+                                                   static_cast<unsigned>(parts.size())),
+                     GeomDeleter{h});
+  GeomPtr u(GEOSUnaryUnion_r(h, collection.get()), GeomDeleter{h});
+  if (!u) throw Error("GEOS UnaryUnion failed");
+  return u;
+}
+
+GeomPtr geometry_of(GEOSContextHandle_t h, const std::vector<GroundPlan>& plans) {
+  std::vector<GEOSGeometry*> parts;
+  for (const GroundPlan& p : plans)
+    if (GEOSGeometry* g = make_polygon(h, p.polygon)) parts.push_back(g);
+  return GeomPtr(GEOSGeom_createCollection_r(h, GEOS_MULTIPOLYGON, parts.data(), static_cast<unsigned>(parts.size())),
+                 GeomDeleter{h});
+}
+
+}  // namespace
+
+std::vector<GroundPlan> geos_union(const std::vector<Footprint>& footprints) {
+  Context ctx;
+  const GEOSContextHandle_t h = ctx.get();
+  GeomPtr u = union_of(h, footprints);
+  std::vector<const GEOSGeometry*> polys;
+  collect_polygons(h, u.get(), polys);
+  std::vector<GroundPlan> plans;
+  plans.reserve(polys.size());
+  for (const GEOSGeometry* g : polys) {
+    GroundPlan plan;
+    plan.polygon = polygon_from(h, g);
+    GEOSArea_r(h, g, &plan.area_m2);
+    plans.push_back(std::move(plan));
+  }
+  return plans;
+}
+
+bool GeosComparison::matches(double rel_tol) const {
+  const double scale = std::max(area_geos, area_ours);
+  return symdiff_area <= rel_tol * scale && polygons_ours == polygons_geos && holes_ours == holes_geos &&
+         invalid_ours == 0 && overlapping_ours == 0;
+}
+
+std::string GeosComparison::summary() const {
+  std::ostringstream s;
+  s.precision(12);
+  s << "area ours " << area_ours << " m2, GEOS " << area_geos << " m2, symmetric difference " << symdiff_area
+    << " m2 (" << (area_geos > 0 ? symdiff_area / area_geos : 0.0) << " relative); polygons " << polygons_ours << " vs "
+    << polygons_geos << "; holes " << holes_ours << " vs " << holes_geos << "; invalid " << invalid_ours
+    << "; overlapping pairs " << overlapping_ours;
+  if (!first_invalid_reason.empty()) s << "; first invalid: " << first_invalid_reason;
+  return s.str();
+}
+
+GeosComparison compare_with_geos(const std::vector<Footprint>& footprints, const std::vector<GroundPlan>& plans,
+                                 const std::vector<GroundPlan>* reference) {
+  Context ctx;
+  const GEOSContextHandle_t h = ctx.get();
+  GeosComparison c;
+
+  GeomPtr ref;
+  if (reference) {
+    ref = geometry_of(h, *reference);
+  } else {
+    ref = union_of(h, footprints);
+  }
+  std::vector<const GEOSGeometry*> ref_polys;
+  collect_polygons(h, ref.get(), ref_polys);
+  c.polygons_geos = ref_polys.size();
+  for (const GEOSGeometry* g : ref_polys) c.holes_geos += static_cast<std::size_t>(GEOSGetNumInteriorRings_r(h, g));
+  GEOSArea_r(h, ref.get(), &c.area_geos);
+
+  // Our plans one by one: validity, holes; then as a whole for the area comparison.
+  std::vector<GEOSGeometry*> ours;
+  for (const GroundPlan& p : plans) {
+    GEOSGeometry* g = make_polygon(h, p.polygon);
+    if (!g) {
+      ++c.invalid_ours;
+      if (c.first_invalid_reason.empty()) c.first_invalid_reason = "outer ring with fewer than 3 points";
+      continue;
+    }
+    if (GEOSisValid_r(h, g) != 1) {
+      ++c.invalid_ours;
+      if (c.first_invalid_reason.empty()) {
+        char* reason = GEOSisValidReason_r(h, g);
+        c.first_invalid_reason = reason ? reason : "invalid";
+        GEOSFree_r(h, reason);
+      }
+    }
+    ++c.polygons_ours;
+    c.holes_ours += p.polygon.holes.size();
+    ours.push_back(g);
+  }
+  // Overlaps between plans: interiors must be disjoint (touching is allowed). STRtree for pairs.
+  {
+    GEOSSTRtree* tree = GEOSSTRtree_create_r(h, 10);
+    for (std::size_t i = 0; i < ours.size(); ++i) GEOSSTRtree_insert_r(h, tree, ours[i], reinterpret_cast<void*>(i));
+    struct QueryState {
+      GEOSContextHandle_t h;
+      const std::vector<GEOSGeometry*>* geoms;
+      std::size_t self;
+      std::size_t overlaps = 0;
+    };
+    for (std::size_t i = 0; i < ours.size(); ++i) {
+      QueryState st{h, &ours, i};
+      GEOSSTRtree_query_r(
+          h, tree, ours[i],
+          [](void* item, void* user) {
+            auto* s = static_cast<QueryState*>(user);
+            const auto j = reinterpret_cast<std::size_t>(item);
+            if (j <= s->self) return;
+            // Interiors intersect <=> DE-9IM pattern T******** .
+            if (GEOSRelatePattern_r(s->h, (*s->geoms)[s->self], (*s->geoms)[j], "T********") == 1) ++s->overlaps;
+          },
+          &st);
+      c.overlapping_ours += st.overlaps;
+    }
+    GEOSSTRtree_destroy_r(h, tree);
+  }
+  for (GEOSGeometry* g : ours) {
+    double a = 0;
+    GEOSArea_r(h, g, &a);
+    c.area_ours += a;
+  }
+  GeomPtr ours_all(GEOSGeom_createCollection_r(h, GEOS_MULTIPOLYGON, ours.data(), static_cast<unsigned>(ours.size())),
+                   GeomDeleter{h});
+  // Symmetric difference of possibly invalid geometry can throw in GEOS: repair ours first when needed.
+  GeomPtr ours_valid(c.invalid_ours || c.overlapping_ours ? GEOSUnaryUnion_r(h, ours_all.get()) : nullptr,
+                     GeomDeleter{h});
+  const GEOSGeometry* a = ours_valid ? ours_valid.get() : ours_all.get();
+  GeomPtr sd(GEOSSymDifference_r(h, a, ref.get()), GeomDeleter{h});
+  if (!sd) {
+    c.symdiff_area = std::numeric_limits<double>::infinity();
+  } else {
+    GEOSArea_r(h, sd.get(), &c.symdiff_area);
+  }
+  return c;
+}
+
+std::string to_wkt(const Polygon& polygon) {
+  Context ctx;
+  const GEOSContextHandle_t h = ctx.get();
+  GeomPtr g(make_polygon(h, polygon), GeomDeleter{h});
+  if (!g) return "POLYGON EMPTY";
+  GEOSWKTWriter* w = GEOSWKTWriter_create_r(h);
+  GEOSWKTWriter_setTrim_r(h, w, 1);
+  GEOSWKTWriter_setRoundingPrecision_r(h, w, 17);
+  char* s = GEOSWKTWriter_write_r(h, w, g.get());
+  std::string out = s ? s : "";
+  GEOSFree_r(h, s);
+  GEOSWKTWriter_destroy_r(h, w);
+  return out;
+}
+
+std::vector<Polygon> polygons_from_wkt(const std::string& wkt) {
+  Context ctx;
+  const GEOSContextHandle_t h = ctx.get();
+  GEOSWKTReader* r = GEOSWKTReader_create_r(h);
+  GeomPtr g(GEOSWKTReader_read_r(h, r, wkt.c_str()), GeomDeleter{h});
+  GEOSWKTReader_destroy_r(h, r);
+  if (!g) throw InvalidArgument("cannot parse WKT: " + wkt.substr(0, 80));
+  std::vector<const GEOSGeometry*> polys;
+  collect_polygons(h, g.get(), polys);
+  std::vector<Polygon> out;
+  for (const GEOSGeometry* p : polys) out.push_back(polygon_from(h, p));
+  return out;
+}
+
+}  // namespace groundplan::gis

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// The correctness reference (DESIGN.md "Correctness is checked against GEOS"): GEOS UnaryUnion of the
+// same footprints through the stable C API, and a comparison of our plans with it. Used by
+// `groundplan --verify`, by the tests and by the benchmarks. Thread-safe (one GEOS context per call).
+#include <groundplan/types.h>
+#include <string>
+#include <vector>
+
+namespace groundplan::gis {
+
+/// GEOS UnaryUnion of every polygon of every footprint, split into one GroundPlan per polygon
+/// (members left empty). Input polygons are made valid with GEOSMakeValid first when GEOS finds them
+/// invalid (self-intersections, repeated points, zero area), as our engine must cope with them too.
+std::vector<GroundPlan> geos_union(const std::vector<Footprint>& footprints);
+
+struct GeosComparison {
+  double area_ours = 0;            // m²
+  double area_geos = 0;
+  double symdiff_area = 0;         // area of (ours XOR geos)
+  std::size_t polygons_ours = 0, polygons_geos = 0;
+  std::size_t holes_ours = 0, holes_geos = 0;
+  std::size_t invalid_ours = 0;    // plans that GEOSisValid rejects
+  std::size_t overlapping_ours = 0;// pairs of our plans whose interiors overlap
+  std::string first_invalid_reason;
+  /// The DESIGN.md criterion: symdiff <= rel_tol * area, same counts, all valid, no overlaps.
+  bool matches(double rel_tol = 1e-9) const;
+  std::string summary() const;     // one line for a person
+};
+
+/// Compares `plans` with GEOS UnaryUnion of `footprints` (computed here unless `reference` is given).
+GeosComparison compare_with_geos(const std::vector<Footprint>& footprints, const std::vector<GroundPlan>& plans,
+                                 const std::vector<GroundPlan>* reference = nullptr);
+
+/// WKT of a polygon (for messages and golden files) and the reverse, through GEOS.
+std::string to_wkt(const Polygon& polygon);
+std::vector<Polygon> polygons_from_wkt(const std::string& wkt);  // Polygon or MultiPolygon; throws InvalidArgument
+
+}  // namespace groundplan::gis
