@@ -1,0 +1,1025 @@
+// SPDX-License-Identifier: MIT
+// Streaming CityGML reader (issue 6). expat in namespace mode: every element arrives as
+// "URI<space>local", so prefixes (and default namespaces) never matter; CityGML 1.0/2.0/3.0 are told
+// apart by the namespace URI family http://www.opengis.net/citygml/... and local names.
+//
+// One BuildingCtx per Building/BuildingPart in flight (a stack, parts nest); polygons are appended to
+// its Mesh as they close. Geometry the ground plan must not see (rooms, installations, furniture,
+// storeys) goes to a side mesh that only serves as an xlink target. xlinks resolve, in order: inside
+// the building (a reference to a polygon the building already has adds nothing: lod2Solid members
+// pointing at the thematic surfaces' polygons would otherwise double every face), in enclosing
+// buildings, in a bounded index of recently delivered buildings, and forward, by holding the building
+// back (bounded) until a later building defines the target.
+#include <groundplan/error.h>
+#include <groundplan/gis/citygml.h>
+
+#include "citygml/coordinates.h"
+
+#include <cpl_vsi.h>
+#include <expat.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <exception>
+#include <map>
+#include <memory>
+#include <unordered_map>
+#include <utility>
+
+namespace groundplan::gis {
+namespace {
+
+constexpr char kSep = ' ';  // namespace URI / local name separator: URIs cannot hold a space
+constexpr int kChunk = 1 << 20;
+constexpr std::uint8_t kNoLod = 255;
+
+enum class Ns : std::uint8_t { None, Gml, CityGml, Xlink, Other };
+
+enum class Tag : std::uint8_t {
+  None,
+  // CityGML (any module, any version)
+  CityModel, Building, BuildingPart, Ground, Roof, Wall, Closure, OtherSurface, Excluded, Skip, MeasuredHeight,
+  LodSurface, LodSkip,
+  // GML
+  Polygon, LinearRing, Exterior, Interior, PosList, Pos, Coordinates, OrientableSurface, Envelope, LowerCorner,
+  UpperCorner, Name, CurveRing,
+};
+
+const std::unordered_map<std::string_view, Tag>& citygml_tags() {
+  static const std::unordered_map<std::string_view, Tag> m = {
+      {"CityModel", Tag::CityModel},
+      {"Building", Tag::Building},
+      {"BuildingPart", Tag::BuildingPart},
+      {"GroundSurface", Tag::Ground},
+      {"RoofSurface", Tag::Roof},
+      {"WallSurface", Tag::Wall},
+      {"ClosureSurface", Tag::Closure},
+      {"OuterCeilingSurface", Tag::OtherSurface},
+      {"OuterFloorSurface", Tag::OtherSurface},
+      {"Window", Tag::OtherSurface},
+      {"Door", Tag::OtherSurface},
+      {"DoorSurface", Tag::OtherSurface},
+      {"WindowSurface", Tag::OtherSurface},
+      // Inside a building but not part of its shell: parsed into the side mesh (xlink targets only).
+      {"BuildingInstallation", Tag::Excluded},
+      {"IntBuildingInstallation", Tag::Excluded},
+      {"Room", Tag::Excluded},
+      {"BuildingFurniture", Tag::Excluded},
+      {"BuildingRoom", Tag::Excluded},
+      {"Storey", Tag::Excluded},
+      {"BuildingUnit", Tag::Excluded},
+      {"BuildingConstructiveElement", Tag::Excluded},
+      {"interiorRoom", Tag::Excluded},
+      {"interiorFurniture", Tag::Excluded},
+      {"outerBuildingInstallation", Tag::Excluded},
+      {"interiorBuildingInstallation", Tag::Excluded},
+      {"buildingInstallation", Tag::Excluded},
+      {"buildingRoom", Tag::Excluded},
+      {"buildingFurniture", Tag::Excluded},
+      {"buildingSubdivision", Tag::Excluded},
+      {"buildingConstructiveElement", Tag::Excluded},
+      // Never geometry of the building's shell, never an xlink target we need.
+      {"appearance", Tag::Skip},
+      {"address", Tag::Skip},
+      {"externalReference", Tag::Skip},
+      {"measuredHeight", Tag::MeasuredHeight},
+  };
+  return m;
+}
+
+const std::unordered_map<std::string_view, Tag>& gml_tags() {
+  static const std::unordered_map<std::string_view, Tag> m = {
+      {"Polygon", Tag::Polygon},
+      {"PolygonPatch", Tag::Polygon},
+      {"Triangle", Tag::Polygon},
+      {"Rectangle", Tag::Polygon},
+      {"LinearRing", Tag::LinearRing},
+      {"exterior", Tag::Exterior},
+      {"outerBoundaryIs", Tag::Exterior},
+      {"interior", Tag::Interior},
+      {"innerBoundaryIs", Tag::Interior},
+      {"posList", Tag::PosList},
+      {"pos", Tag::Pos},
+      {"coordinates", Tag::Coordinates},
+      {"OrientableSurface", Tag::OrientableSurface},
+      {"Envelope", Tag::Envelope},
+      {"lowerCorner", Tag::LowerCorner},
+      {"upperCorner", Tag::UpperCorner},
+      {"name", Tag::Name},
+      {"Ring", Tag::CurveRing},
+  };
+  return m;
+}
+
+Ns classify_ns(std::string_view uri) {
+  if (uri.empty()) return Ns::None;
+  if (uri == "http://www.opengis.net/gml" || uri == "http://www.opengis.net/gml/3.2") return Ns::Gml;
+  if (uri.starts_with("http://www.opengis.net/citygml/")) return Ns::CityGml;
+  if (uri == "http://www.w3.org/1999/xlink") return Ns::Xlink;
+  return Ns::Other;
+}
+
+// Attribute names in namespace mode: "srsName" (no namespace) or "URI local".
+struct Attrs {
+  const char* gml_id = nullptr;
+  const char* href = nullptr;
+  const char* srs_name = nullptr;
+  const char* srs_dimension = nullptr;
+  const char* orientation = nullptr;
+  const char* cs = nullptr;
+  const char* ts = nullptr;
+  const char* decimal = nullptr;
+};
+
+Attrs scan_attrs(const char** atts) {
+  Attrs a;
+  for (; *atts; atts += 2) {
+    const char* n = atts[0];
+    const char* sp = std::strrchr(n, kSep);
+    if (!sp) {
+      switch (n[0]) {
+        case 's':
+          if (!std::strcmp(n, "srsName")) a.srs_name = atts[1];
+          else if (!std::strcmp(n, "srsDimension")) a.srs_dimension = atts[1];
+          break;
+        case 'o':
+          if (!std::strcmp(n, "orientation")) a.orientation = atts[1];
+          break;
+        case 'c':
+          if (!std::strcmp(n, "cs")) a.cs = atts[1];
+          break;
+        case 't':
+          if (!std::strcmp(n, "ts")) a.ts = atts[1];
+          break;
+        case 'd':
+          if (!std::strcmp(n, "decimal")) a.decimal = atts[1];
+          break;
+        default:
+          break;
+      }
+    } else {
+      std::string_view local(sp + 1);
+      std::string_view uri(n, static_cast<std::size_t>(sp - n));
+      if (local == "id" && classify_ns(uri) == Ns::Gml) a.gml_id = atts[1];
+      else if (local == "href" && uri == "http://www.w3.org/1999/xlink") a.href = atts[1];
+    }
+  }
+  return a;
+}
+
+/// "lod2Solid" -> lod 2, surface geometry; "lod2TerrainIntersection" -> skip. Returns false if not lodN*.
+bool parse_lod_property(std::string_view local, std::uint8_t& lod, Tag& tag, SurfaceKind& kind) {
+  if (local.size() < 5 || !local.starts_with("lod") || local[3] < '0' || local[3] > '4') return false;
+  lod = static_cast<std::uint8_t>(local[3] - '0');
+  std::string_view rest = local.substr(4);
+  kind = SurfaceKind::Unknown;
+  if (rest == "Solid" || rest == "MultiSurface" || rest == "Geometry" || rest == "CompositeSurface") {
+    tag = Tag::LodSurface;
+  } else if (rest == "FootPrint") {
+    tag = Tag::LodSurface;
+    kind = SurfaceKind::FootPrint;
+  } else if (rest == "RoofEdge") {
+    tag = Tag::LodSurface;
+    kind = SurfaceKind::RoofEdge;
+  } else {
+    tag = Tag::LodSkip;  // MultiCurve, TerrainIntersection, ImplicitRepresentation, Point, attributes like lod1HeightType
+  }
+  return true;
+}
+
+struct IdRange {
+  bool side = false;  // in the side mesh (rooms, installations ...)
+  std::uint32_t first = 0, last = 0;  // faces [first, last)
+};
+
+struct XRef {
+  std::string id;
+  SurfaceKind kind = SurfaceKind::Unknown;
+  std::uint8_t lod = kNoLod;
+  bool flip = false;
+  bool side = false;  // the reference itself sits in excluded geometry
+};
+
+struct BuildingCtx {
+  Mesh mesh;
+  Mesh side;
+  std::unordered_map<std::string, IdRange> ids;
+  std::vector<XRef> refs;
+  std::size_t depth = 0;
+  bool is_part = false;
+  bool has_parts = false;
+  // code -> (count, first reason): one Problem per code per building
+  std::map<std::string, std::pair<std::size_t, std::string>> defects;
+
+  void defect(const std::string& code, const std::string& reason) {
+    auto& d = defects[code];
+    if (d.first++ == 0) d.second = reason;
+  }
+};
+
+/// A delivered building kept for backward xlinks from later buildings.
+struct IndexedBuilding {
+  Mesh mesh;
+  Mesh side;
+  std::unordered_map<std::string, IdRange> ids;
+  std::size_t vertices = 0;
+};
+
+struct Frame {
+  Tag tag = Tag::None;
+  std::uint8_t lod = kNoLod;
+  SurfaceKind kind = SurfaceKind::Unknown;
+  bool flip = false;
+  bool excluded = false;
+  std::uint8_t dim = 0;  // srsDimension in force, 0 = not said
+};
+
+struct IdMark {
+  std::string id;
+  std::size_t depth;
+  std::uint32_t first_face;
+  bool side;
+};
+
+enum class Capture : std::uint8_t { None, Coords, Name, MeasuredHeight, EnvLower, EnvUpper, EnvPos };
+
+void copy_faces(const Mesh& from, std::uint32_t first, std::uint32_t last, Mesh& to, const XRef& ref) {
+  std::vector<std::vector<Point3>> rings;
+  for (std::uint32_t f = first; f < last; ++f) {
+    const MeshFace& face = from.faces[f];
+    rings.clear();
+    for (std::uint32_t r = face.first_ring; r < face.first_ring + face.ring_count; ++r) {
+      std::vector<Point3> ring;
+      for (std::uint32_t k = from.ring_offsets[r]; k < from.ring_offsets[r + 1]; ++k)
+        ring.push_back(from.vertices[from.indices[k]]);
+      if (ref.flip) std::reverse(ring.begin() + 1, ring.end());
+      rings.push_back(std::move(ring));
+    }
+    SurfaceKind kind = ref.kind != SurfaceKind::Unknown ? ref.kind : face.kind;
+    std::uint8_t lod = ref.lod != kNoLod ? ref.lod : face.lod;
+    to.add_face(rings, kind, lod);
+  }
+}
+
+class Reader {
+ public:
+  Reader(const std::string& name, const CityGmlOptions& opt, const MeshCallback& cb, std::vector<Problem>& problems,
+         SourceInfo& info)
+      : name_(name), opt_(opt), cb_(cb), problems_(problems), info_(info) {
+    info_.file = name;
+    parser_ = XML_ParserCreateNS(nullptr, kSep);
+    if (!parser_) throw Error("out of memory creating the XML parser");
+    XML_SetUserData(parser_, this);
+    XML_SetElementHandler(parser_, &Reader::on_start, &Reader::on_end);
+    // Hostile input (issue 6): no DTD loading, no parameter entities, and any entity declaration
+    // stops the parse (billion laughs, external entities such as file:///etc/passwd). No external
+    // entity handler is installed, so expat never opens anything.
+    XML_SetParamEntityParsing(parser_, XML_PARAM_ENTITY_PARSING_NEVER);
+    XML_SetEntityDeclHandler(parser_, &Reader::on_entity_decl);
+    XML_SetUnparsedEntityDeclHandler(parser_, &Reader::on_unparsed_entity_decl);
+    frames_.reserve(64);
+    frames_.push_back(Frame{});
+  }
+  ~Reader() {
+    XML_ParserFree(parser_);
+  }
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+
+  /// Feeds one chunk; `last` on the final one. Throws on any error.
+  void feed(const char* data, std::size_t n, bool last) {
+    void* buf = XML_GetBuffer(parser_, static_cast<int>(n > 0 ? n : 1));
+    if (!buf) throw Error("out of memory in the XML parser reading " + name_);
+    if (n) std::memcpy(buf, data, n);
+    parse_buffer(n, last);
+  }
+
+  /// Reads straight into expat's buffer (no copy). Returns bytes read.
+  template <class ReadFn>
+  std::size_t feed_from(ReadFn&& read) {
+    void* buf = XML_GetBuffer(parser_, kChunk);
+    if (!buf) throw Error("out of memory in the XML parser reading " + name_);
+    std::size_t n = read(buf, static_cast<std::size_t>(kChunk));
+    parse_buffer(n, n == 0);
+    return n;
+  }
+
+  void finish() {
+    // Buildings still waiting for a forward xlink target: the target never came.
+    while (!pending_.empty()) {
+      auto ctx = std::move(pending_.front());
+      pending_.pop_front();
+      give_up_refs(*ctx);
+      deliver(std::move(ctx));
+    }
+    if (info_.citygml_version.empty()) {
+      problems_.push_back(Problem{"", name_, "read", "NOT_CITYGML",
+                                  "no CityGML namespace (http://www.opengis.net/citygml/...) in the file: "
+                                  "nothing read from it"});
+    }
+    if (info_.srs_mixed) {
+      problems_.push_back(Problem{"", name_, "read", "MIXED_SRS",
+                                  "the file uses srsName \"" + info_.srs_name + "\" and also \"" +
+                                      info_.other_srs_name + "\"; every coordinate is taken as in the first"});
+    }
+  }
+
+ private:
+  void parse_buffer(std::size_t n, bool last) {
+    info_.bytes += n;
+    XML_Status st = XML_ParseBuffer(parser_, static_cast<int>(n), last ? XML_TRUE : XML_FALSE);
+    if (pending_exception_) std::rethrow_exception(pending_exception_);
+    if (!stop_reason_.empty()) throw InputError(name_ + ": " + stop_reason_);
+    if (st != XML_STATUS_OK) {
+      XML_Error code = XML_GetErrorCode(parser_);
+      std::string msg = name_ + ": not well-formed XML at line " + std::to_string(XML_GetCurrentLineNumber(parser_)) +
+                        ", column " + std::to_string(XML_GetCurrentColumnNumber(parser_)) + ": " +
+                        XML_ErrorString(code);
+      if (code == XML_ERROR_NO_ELEMENTS || code == XML_ERROR_UNCLOSED_TOKEN || code == XML_ERROR_PARTIAL_CHAR ||
+          code == XML_ERROR_UNCLOSED_CDATA_SECTION)
+        msg += " (the file looks truncated; buildings before this point were read)";
+      else
+        msg += " (is this a CityGML file?)";
+      throw InputError(msg);
+    }
+  }
+
+  void stop(std::string reason) {
+    if (stop_reason_.empty()) stop_reason_ = std::move(reason);
+    XML_StopParser(parser_, XML_FALSE);
+  }
+
+  static void XMLCALL on_entity_decl(void* ud, const XML_Char* name, int, const XML_Char*, int, const XML_Char*,
+                                     const XML_Char*, const XML_Char*, const XML_Char*) {
+    auto* self = static_cast<Reader*>(ud);
+    self->stop(std::string("the document declares the entity \"") + name +
+               "\"; entity declarations are refused (they serve entity-expansion and external-entity attacks, and "
+               "CityGML has no use for them)");
+  }
+  static void XMLCALL on_unparsed_entity_decl(void* ud, const XML_Char* name, const XML_Char*, const XML_Char*,
+                                              const XML_Char*, const XML_Char*) {
+    on_entity_decl(ud, name, 0, nullptr, 0, nullptr, nullptr, nullptr, nullptr);
+  }
+
+  static void XMLCALL on_start(void* ud, const XML_Char* name, const XML_Char** atts) {
+    auto* self = static_cast<Reader*>(ud);
+    try {
+      self->start(name, atts);
+    } catch (...) {
+      self->pending_exception_ = std::current_exception();
+      XML_StopParser(self->parser_, XML_FALSE);
+    }
+  }
+  static void XMLCALL on_end(void* ud, const XML_Char* name) {
+    auto* self = static_cast<Reader*>(ud);
+    try {
+      self->end();
+    } catch (...) {
+      self->pending_exception_ = std::current_exception();
+      XML_StopParser(self->parser_, XML_FALSE);
+    }
+  }
+  static void XMLCALL on_text(void* ud, const XML_Char* s, int len) {
+    static_cast<Reader*>(ud)->text_.append(s, static_cast<std::size_t>(len));
+  }
+
+  void begin_capture(Capture c) {
+    capture_ = c;
+    capture_depth_ = frames_.size() + 1;  // called from start(), before its frame is pushed
+    text_.clear();
+    XML_SetCharacterDataHandler(parser_, &Reader::on_text);
+  }
+  void end_capture() {
+    capture_ = Capture::None;
+    XML_SetCharacterDataHandler(parser_, nullptr);
+  }
+
+  BuildingCtx* building() { return buildings_.empty() ? nullptr : buildings_.back().get(); }
+
+  void start(const char* name, const char** atts) {
+    if (skip_depth_) {  // inside a subtree we ignore entirely
+      if (++skip_level_ + frames_.size() > opt_.max_depth)
+        stop("XML nesting deeper than " + std::to_string(opt_.max_depth) + " levels; refused as hostile or broken");
+      return;
+    }
+    if (frames_.size() > opt_.max_depth) {
+      stop("XML nesting deeper than " + std::to_string(opt_.max_depth) + " levels; refused as hostile or broken");
+      return;
+    }
+    const std::size_t depth = frames_.size() + 1;  // this element's depth once its frame is pushed
+    const char* sp = std::strrchr(name, kSep);
+    std::string_view local = sp ? std::string_view(sp + 1) : std::string_view(name);
+    Ns ns = sp ? classify_ns(std::string_view(name, static_cast<std::size_t>(sp - name))) : Ns::None;
+
+    Frame f = frames_.back();
+    f.tag = Tag::None;
+    Attrs a = atts[0] ? scan_attrs(atts) : Attrs{};
+    if (a.srs_name) note_srs(a.srs_name);
+    if (a.srs_dimension) {
+      int d = std::atoi(a.srs_dimension);
+      if (d == 2 || d == 3) {
+        f.dim = static_cast<std::uint8_t>(d);
+        if (!info_.srs_dimension) info_.srs_dimension = d;
+      }
+    }
+    BuildingCtx* b = building();
+
+    if (ns == Ns::CityGml) {
+      if (info_.citygml_version.empty()) note_version(std::string_view(name, static_cast<std::size_t>(sp - name)));
+      auto it = citygml_tags().find(local);
+      Tag t = it == citygml_tags().end() ? Tag::None : it->second;
+      std::uint8_t lod;
+      SurfaceKind lod_kind;
+      if (t == Tag::None && parse_lod_property(local, lod, t, lod_kind)) {
+        if (t == Tag::LodSkip) {
+          if (b) return begin_skip();
+        } else {
+          f.lod = lod;
+          if (lod_kind != SurfaceKind::Unknown) f.kind = lod_kind;
+          if (b && a.href) add_ref(*b, a.href, f);
+        }
+      }
+      f.tag = t;
+      switch (t) {
+        case Tag::Building:
+        case Tag::BuildingPart:
+          open_building(t == Tag::BuildingPart, a.gml_id);
+          f = Frame{};
+          f.tag = t;
+          f.dim = frames_.back().dim;
+          break;
+        case Tag::Ground: f.kind = SurfaceKind::Ground; break;
+        case Tag::Roof: f.kind = SurfaceKind::Roof; break;
+        case Tag::Wall: f.kind = SurfaceKind::Wall; break;
+        case Tag::Closure: f.kind = SurfaceKind::Closure; break;
+        case Tag::OtherSurface: f.kind = SurfaceKind::Other; break;
+        case Tag::Excluded: f.excluded = true; break;
+        case Tag::Skip:
+          if (b) return begin_skip();
+          break;
+        case Tag::MeasuredHeight:
+          if (b && depth == b->depth + 1) begin_capture(Capture::MeasuredHeight);
+          break;
+        default:
+          break;
+      }
+    } else if (ns == Ns::Gml) {
+      auto it = gml_tags().find(local);
+      Tag t = it == gml_tags().end() ? Tag::None : it->second;
+      f.tag = t;
+      if (b) {
+        if (a.gml_id) ids_.push_back(IdMark{a.gml_id, depth, face_count(*b, f.excluded), f.excluded});
+        if (a.href) add_ref(*b, a.href, f);
+        switch (t) {
+          case Tag::Polygon:
+            begin_polygon(a.gml_id);
+            break;
+          case Tag::Exterior:
+          case Tag::Interior:
+            if (in_polygon_ && depth == poly_depth_ + 1) ring_role_ = t == Tag::Exterior ? 1 : 2;
+            break;
+          case Tag::LinearRing:
+            if (in_polygon_ && ring_role_) {
+              in_ring_ = true;
+              ring_.clear();
+            }
+            break;
+          case Tag::PosList:
+          case Tag::Pos:
+          case Tag::Coordinates:
+            if (in_ring_) {
+              coord_dim_attr_ = a.srs_dimension ? std::atoi(a.srs_dimension) : 0;
+              cs_ = a.cs && *a.cs ? a.cs[0] : ',';
+              ts_ = a.ts && *a.ts ? a.ts[0] : ' ';
+              decimal_ = a.decimal && *a.decimal ? a.decimal[0] : '.';
+              begin_capture(Capture::Coords);
+            }
+            break;
+          case Tag::OrientableSurface:
+            if (a.orientation && a.orientation[0] == '-') f.flip = !f.flip;
+            break;
+          case Tag::Name:
+            if (depth == b->depth + 1 && b->mesh.name.empty()) begin_capture(Capture::Name);
+            break;
+          case Tag::CurveRing:
+            if (in_polygon_) {
+              b->defect("UNSUPPORTED_GEOMETRY", "gml:Ring (a ring of curve segments) is not supported; polygon " +
+                                                    poly_label() + " was dropped");
+              poly_ok_ = false;
+            }
+            break;
+          default:
+            break;
+        }
+      } else {
+        // Outside buildings only the first envelope matters (where the data lies, for the UTM choice).
+        if (t == Tag::Envelope && !info_.has_envelope && !env_done_) in_envelope_ = true;
+        if (in_envelope_) {
+          if (t == Tag::LowerCorner) begin_capture(Capture::EnvLower);
+          else if (t == Tag::UpperCorner) begin_capture(Capture::EnvUpper);
+          else if (t == Tag::Pos) begin_capture(Capture::EnvPos);
+        }
+      }
+    }
+    frames_.push_back(f);
+  }
+
+  void begin_skip() {
+    skip_depth_ = true;
+    skip_level_ = 1;
+  }
+
+  void end() {
+    if (skip_depth_) {
+      if (--skip_level_ == 0) skip_depth_ = false;
+      return;
+    }
+    const Frame f = frames_.back();
+    const std::size_t depth = frames_.size();
+    frames_.pop_back();
+    BuildingCtx* b = building();
+
+    if (capture_ != Capture::None && capture_depth_ == depth) finish_capture(b, f);
+
+    if (b) {
+      switch (f.tag) {
+        case Tag::LinearRing:
+          if (in_ring_) finish_ring(*b);
+          break;
+        case Tag::Exterior:
+        case Tag::Interior:
+          if (in_polygon_ && depth == poly_depth_ + 1) ring_role_ = 0;
+          break;
+        case Tag::Polygon:
+          if (in_polygon_ && depth == poly_depth_) finish_polygon(*b, f);
+          break;
+        default:
+          break;
+      }
+      while (!ids_.empty() && ids_.back().depth == depth) {
+        IdMark& m = ids_.back();
+        std::uint32_t last = face_count(*b, m.side);
+        if (last > m.first_face) b->ids.emplace(std::move(m.id), IdRange{m.side, m.first_face, last});
+        ids_.pop_back();
+      }
+      if ((f.tag == Tag::Building || f.tag == Tag::BuildingPart) && depth == b->depth) close_building();
+    } else if (f.tag == Tag::Envelope && in_envelope_) {
+      in_envelope_ = false;
+      env_done_ = true;
+      if (env_points_ >= 2) info_.has_envelope = true;
+    }
+  }
+
+  void finish_capture(BuildingCtx* b, const Frame& f) {
+    Capture c = capture_;
+    end_capture();
+    switch (c) {
+      case Capture::Coords:
+        if (b) add_coordinates(*b, f);
+        break;
+      case Capture::Name:
+        if (b) {
+          std::size_t s = text_.find_first_not_of(" \t\r\n");
+          std::size_t e = text_.find_last_not_of(" \t\r\n");
+          if (s != std::string::npos) b->mesh.name = text_.substr(s, e - s + 1);
+        }
+        break;
+      case Capture::MeasuredHeight:
+        if (b) {
+          std::vector<double> v;
+          if (detail::parse_numbers(text_, v) == detail::CoordStatus::Ok && v.size() == 1)
+            b->mesh.measured_height = v[0];
+          else
+            b->defect("BAD_ATTRIBUTE", "measuredHeight \"" + text_.substr(0, 40) + "\" is not a number; ignored");
+        }
+        break;
+      case Capture::EnvLower:
+      case Capture::EnvUpper:
+      case Capture::EnvPos: {
+        std::vector<double> v;
+        if (detail::parse_numbers(text_, v) != detail::CoordStatus::Ok || v.size() < 2) break;
+        bool lower = c == Capture::EnvLower || (c == Capture::EnvPos && env_points_ == 0);
+        double* dst = lower ? info_.envelope_lower : info_.envelope_upper;
+        for (std::size_t k = 0; k < 3; ++k) dst[k] = k < v.size() ? v[k] : 0;
+        ++env_points_;
+        break;
+      }
+      case Capture::None:
+        break;
+    }
+  }
+
+  void note_srs(const char* srs) {
+    if (info_.srs_name.empty()) {
+      info_.srs_name = srs;
+    } else if (!info_.srs_mixed && info_.srs_name != srs) {
+      info_.srs_mixed = true;
+      info_.other_srs_name = srs;
+    }
+  }
+
+  void note_version(std::string_view uri) {
+    // .../citygml/2.0, .../citygml/building/1.0, .../citygml/construction/3.0
+    if (uri.size() >= 3) {
+      std::string_view tail = uri.substr(uri.size() - 3);
+      if (tail[0] >= '0' && tail[0] <= '9' && tail[1] == '.' && tail[2] >= '0' && tail[2] <= '9')
+        info_.citygml_version = std::string(tail);
+    }
+  }
+
+  // --- buildings --------------------------------------------------------------------------------
+
+  void open_building(bool is_part, const char* id) {
+    if (is_part) ++info_.building_parts;
+    else ++info_.buildings;
+    auto ctx = std::make_unique<BuildingCtx>();
+    ctx->depth = frames_.size() + 1;  // the frame this start pushes
+    ctx->is_part = is_part;
+    ctx->mesh.source_file = name_;
+    if (id && *id) {
+      ctx->mesh.source_id = id;
+    } else {
+      ctx->mesh.source_id = std::string(is_part ? "BuildingPart" : "Building") + "#" +
+                            std::to_string(info_.buildings + info_.building_parts) + "@line" +
+                            std::to_string(XML_GetCurrentLineNumber(parser_));
+    }
+    if (BuildingCtx* parent = building()) {
+      parent->has_parts = true;
+      ctx->mesh.parent_id = parent->mesh.source_id;
+    }
+    buildings_.push_back(std::move(ctx));
+    in_polygon_ = in_ring_ = false;
+  }
+
+  void close_building() {
+    std::unique_ptr<BuildingCtx> ctx = std::move(buildings_.back());
+    buildings_.pop_back();
+    resolve_refs(*ctx);
+    std::unique_ptr<BuildingCtx> done;
+    if (!ctx->refs.empty()) {
+      if (pending_.size() >= opt_.max_pending_buildings) {
+        // No room to wait any longer: the oldest waiting building goes out with what it has.
+        auto oldest = std::move(pending_.front());
+        pending_.pop_front();
+        give_up_refs(*oldest);
+        deliver(std::move(oldest));
+      }
+      pending_.push_back(std::move(ctx));
+      return;
+    }
+    deliver(std::move(ctx));
+  }
+
+  /// Resolves what it can; leaves the rest in ctx.refs.
+  void resolve_refs(BuildingCtx& ctx) {
+    std::vector<XRef> left;
+    for (XRef& r : ctx.refs) {
+      auto own = ctx.ids.find(r.id);
+      if (own != ctx.ids.end()) {
+        // The building has it already: the reference adds nothing, unless the shell points into
+        // geometry kept aside (an installation's polygon used in the solid).
+        if (own->second.side && !r.side) copy_faces(ctx.side, own->second.first, own->second.last, ctx.mesh, r);
+        ++info_.xlinks_resolved;
+        continue;
+      }
+      if (resolve_from_open(ctx, r) || resolve_from_index(ctx, r)) {
+        ++info_.xlinks_resolved;
+        continue;
+      }
+      left.push_back(std::move(r));
+    }
+    ctx.refs = std::move(left);
+  }
+
+  bool resolve_from(const Mesh& main, const Mesh& side, const std::unordered_map<std::string, IdRange>& ids,
+                    BuildingCtx& ctx, const XRef& r) {
+    auto it = ids.find(r.id);
+    if (it == ids.end()) return false;
+    const IdRange& range = it->second;
+    copy_faces(range.side ? side : main, range.first, range.last, r.side ? ctx.side : ctx.mesh, r);
+    return true;
+  }
+
+  bool resolve_from_open(BuildingCtx& ctx, const XRef& r) {
+    for (auto& open : buildings_)
+      if (resolve_from(open->mesh, open->side, open->ids, ctx, r)) return true;
+    return false;
+  }
+
+  bool resolve_from_index(BuildingCtx& ctx, const XRef& r) {
+    for (auto it = index_.rbegin(); it != index_.rend(); ++it)
+      if (resolve_from((*it)->mesh, (*it)->side, (*it)->ids, ctx, r)) return true;
+    return false;
+  }
+
+  void give_up_refs(BuildingCtx& ctx) {
+    for (const XRef& r : ctx.refs) {
+      ++info_.xlinks_missing;
+      ctx.defect("XLINK_TARGET_MISSING", "xlink:href=\"#" + r.id +
+                                             "\" names no geometry found in the file (or too far from the reference "
+                                             "to be kept); that surface is missing from the building");
+    }
+    ctx.refs.clear();
+  }
+
+  void deliver(std::unique_ptr<BuildingCtx> ctx) {
+    // Keep a copy for backward xlinks from later buildings, before the LoD filter changes face numbers.
+    if (opt_.xlink_index_max_vertices > 0 && !ctx->ids.empty()) {
+      auto ib = std::make_unique<IndexedBuilding>();
+      ib->mesh.vertices = ctx->mesh.vertices;
+      ib->mesh.indices = ctx->mesh.indices;
+      ib->mesh.ring_offsets = ctx->mesh.ring_offsets;
+      ib->mesh.faces = ctx->mesh.faces;
+      ib->side = std::move(ctx->side);
+      ib->ids = std::move(ctx->ids);
+      ib->vertices = ib->mesh.vertices.size() + ib->side.vertices.size();
+      index_vertices_ += ib->vertices;
+      index_.push_back(std::move(ib));
+      while (index_vertices_ > opt_.xlink_index_max_vertices && !index_.empty()) {
+        index_vertices_ -= index_.front()->vertices;
+        index_.pop_front();
+      }
+      // Buildings waiting for a forward reference: maybe this one defines it.
+      if (!pending_.empty()) retry_pending(*index_.back());
+    }
+    emit(*ctx);
+  }
+
+  void retry_pending(const IndexedBuilding& ib) {
+    for (std::size_t k = 0; k < pending_.size();) {
+      BuildingCtx& p = *pending_[k];
+      std::vector<XRef> left;
+      for (XRef& r : p.refs) {
+        if (resolve_from(ib.mesh, ib.side, ib.ids, p, r)) ++info_.xlinks_resolved;
+        else left.push_back(std::move(r));
+      }
+      p.refs = std::move(left);
+      if (p.refs.empty()) {
+        auto ctx = std::move(pending_[k]);
+        pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(k));
+        deliver(std::move(ctx));  // may recurse into retry_pending; indices restart below
+        k = 0;
+      } else {
+        ++k;
+      }
+    }
+  }
+
+  void emit(BuildingCtx& ctx) {
+    Mesh& m = ctx.mesh;
+    for (auto& [code, d] : ctx.defects) {
+      std::string reason = d.second;
+      if (d.first > 1) reason += " (and " + std::to_string(d.first - 1) + " more like it)";
+      problems_.push_back(Problem{m.source_id, name_, "read", code, reason});
+    }
+    if (m.faces.empty()) {
+      if (ctx.has_parts) return;  // the parts carry the building
+      problems_.push_back(Problem{m.source_id, name_, "read", "NO_GEOMETRY",
+                                  std::string(ctx.is_part ? "BuildingPart" : "Building") +
+                                      " has no surface geometry (no polygon in any lod0-lod4 property)"});
+      return;
+    }
+    // LoD choice: the highest the building has, or the one asked for. Faces without a LoD stay.
+    int have = 0;  // bit mask of LoDs present
+    for (const MeshFace& f : m.faces)
+      if (f.lod <= 4) have |= 1 << f.lod;
+    if (have) {
+      int want = opt_.lod;
+      if (want < 0) {
+        want = 4;
+        while (!(have & (1 << want))) --want;
+      }
+      if (!(have & (1 << want))) {
+        std::string avail;
+        for (int l = 0; l <= 4; ++l)
+          if (have & (1 << l)) avail += (avail.empty() ? "" : ", ") + std::to_string(l);
+        if (ctx.has_parts) return;
+        problems_.push_back(Problem{m.source_id, name_, "read", "NO_GEOMETRY_AT_LOD",
+                                    "no geometry at LoD " + std::to_string(want) + " (the building has LoD " + avail +
+                                        ")"});
+        return;
+      }
+      if (have != (1 << want)) filter_lod(m, static_cast<std::uint8_t>(want));
+    }
+    ++info_.meshes;
+    info_.faces += m.faces.size();
+    cb_(std::move(m));
+  }
+
+  static void filter_lod(Mesh& m, std::uint8_t lod) {
+    Mesh out;
+    out.source_id = std::move(m.source_id);
+    out.parent_id = std::move(m.parent_id);
+    out.source_file = std::move(m.source_file);
+    out.name = std::move(m.name);
+    out.measured_height = m.measured_height;
+    for (const MeshFace& f : m.faces) {
+      if (f.lod != lod && f.lod != kNoLod) continue;
+      MeshFace nf = f;
+      nf.first_ring = static_cast<std::uint32_t>(out.ring_count());
+      for (std::uint32_t r = f.first_ring; r < f.first_ring + f.ring_count; ++r) {
+        for (std::uint32_t k = m.ring_offsets[r]; k < m.ring_offsets[r + 1]; ++k) {
+          out.indices.push_back(static_cast<std::uint32_t>(out.vertices.size()));
+          out.vertices.push_back(m.vertices[m.indices[k]]);
+        }
+        out.ring_offsets.push_back(static_cast<std::uint32_t>(out.indices.size()));
+      }
+      out.faces.push_back(nf);
+    }
+    m = std::move(out);
+  }
+
+  static std::uint32_t face_count(const BuildingCtx& b, bool side) {
+    return static_cast<std::uint32_t>(side ? b.side.faces.size() : b.mesh.faces.size());
+  }
+
+  void add_ref(BuildingCtx& b, const char* href, const Frame& f) {
+    if (href[0] != '#') {
+      b.defect("EXTERNAL_XLINK", std::string("xlink:href=\"") + std::string(href).substr(0, 120) +
+                                     "\" points outside the file; external references are never followed");
+      return;
+    }
+    XRef r;
+    r.id = href + 1;
+    r.kind = f.kind;
+    r.lod = f.lod;
+    r.flip = f.flip;
+    r.side = f.excluded;
+    // OrientableSurface orientation="-" on the referencing element itself
+    b.refs.push_back(std::move(r));
+  }
+
+  // --- polygons ---------------------------------------------------------------------------------
+
+  void begin_polygon(const char* id) {
+    in_polygon_ = true;
+    poly_ok_ = true;
+    poly_depth_ = frames_.size() + 1;
+    poly_rings_.clear();
+    poly_has_exterior_ = false;
+    poly_id_ = id ? id : "";
+    ring_role_ = 0;
+    in_ring_ = false;
+  }
+
+  std::string poly_label() const {
+    return poly_id_.empty() ? "at line " + std::to_string(XML_GetCurrentLineNumber(parser_)) : "\"" + poly_id_ + "\"";
+  }
+
+  void add_coordinates(BuildingCtx& b, const Frame& f) {
+    coords_.clear();
+    detail::CoordStatus st;
+    int dim = 0;
+    if (f.tag == Tag::Coordinates) {
+      st = detail::parse_gml_coordinates(text_, cs_, ts_, decimal_, coords_, dim);
+      if (st == detail::CoordStatus::Ok && dim != 2 && dim != 3) st = detail::CoordStatus::BadNumber;
+    } else {
+      st = detail::parse_numbers(text_, coords_);
+      if (st == detail::CoordStatus::Ok) {
+        if (f.tag == Tag::Pos) {
+          dim = static_cast<int>(coords_.size());
+        } else if (coord_dim_attr_ == 2 || coord_dim_attr_ == 3) {
+          dim = coord_dim_attr_;
+        } else if (f.dim) {
+          dim = f.dim;
+        } else {
+          dim = detail::infer_dimension(coords_, 0, info_.srs_dimension ? info_.srs_dimension : 3);
+        }
+        if ((dim != 2 && dim != 3) || coords_.size() % static_cast<std::size_t>(dim) != 0)
+          st = detail::CoordStatus::BadNumber;
+      }
+    }
+    if (st != detail::CoordStatus::Ok) {
+      if (poly_ok_) {
+        if (st == detail::CoordStatus::NotFinite)
+          b.defect("NOT_FINITE", "polygon " + poly_label() + " has a NaN or infinite coordinate; dropped");
+        else
+          b.defect("BAD_COORDINATES", "polygon " + poly_label() + ": \"" + text_.substr(0, 60) +
+                                          "\" is not a list of 2D/3D coordinates; dropped");
+      }
+      poly_ok_ = false;
+      return;
+    }
+    for (std::size_t k = 0; k + dim <= coords_.size(); k += static_cast<std::size_t>(dim))
+      ring_.push_back(Point3{coords_[k], coords_[k + 1], dim == 3 ? coords_[k + 2] : 0.0});
+  }
+
+  void finish_ring(BuildingCtx& b) {
+    in_ring_ = false;
+    if (!poly_ok_) return;
+    if (ring_.size() >= 2 && ring_.front() == ring_.back()) ring_.pop_back();
+    std::size_t distinct = 0;
+    for (std::size_t k = 0; k < ring_.size(); ++k)
+      if (k == 0 || !(ring_[k] == ring_[k - 1])) ++distinct;
+    if (distinct < 3) {
+      if (ring_role_ == 1) {
+        b.defect("TOO_FEW_POINTS", "polygon " + poly_label() + ": exterior ring has " + std::to_string(distinct) +
+                                       " distinct points (at least 3 needed); dropped");
+        poly_ok_ = false;
+      } else {
+        b.defect("TOO_FEW_POINTS", "polygon " + poly_label() + ": interior ring has " + std::to_string(distinct) +
+                                       " distinct points; that hole was dropped");
+      }
+      return;
+    }
+    if (ring_role_ == 1) {
+      if (poly_has_exterior_) {
+        poly_ok_ = false;
+        b.defect("BAD_POLYGON", "polygon " + poly_label() + " has two exterior rings; dropped");
+        return;
+      }
+      poly_has_exterior_ = true;
+      poly_rings_.insert(poly_rings_.begin(), ring_);
+    } else {
+      poly_rings_.push_back(ring_);
+    }
+  }
+
+  void finish_polygon(BuildingCtx& b, const Frame& f) {
+    in_polygon_ = false;
+    if (!poly_ok_) return;
+    if (!poly_has_exterior_) {
+      b.defect("BAD_POLYGON", "polygon " + poly_label() + " has no exterior ring; dropped");
+      return;
+    }
+    if (f.flip)
+      for (auto& r : poly_rings_) std::reverse(r.begin() + 1, r.end());
+    (f.excluded ? b.side : b.mesh).add_face(poly_rings_, f.kind, f.lod);
+  }
+
+  std::string name_;
+  const CityGmlOptions& opt_;
+  const MeshCallback& cb_;
+  std::vector<Problem>& problems_;
+  SourceInfo& info_;
+  XML_Parser parser_ = nullptr;
+  std::exception_ptr pending_exception_;
+  std::string stop_reason_;
+
+  std::vector<Frame> frames_;
+  bool skip_depth_ = false;
+  std::size_t skip_level_ = 0;
+  std::vector<std::unique_ptr<BuildingCtx>> buildings_;
+  std::vector<IdMark> ids_;
+  std::deque<std::unique_ptr<BuildingCtx>> pending_;
+  std::deque<std::unique_ptr<IndexedBuilding>> index_;
+  std::size_t index_vertices_ = 0;
+
+  Capture capture_ = Capture::None;
+  std::size_t capture_depth_ = 0;
+  std::string text_;
+  std::vector<double> coords_;
+  int coord_dim_attr_ = 0;
+  char cs_ = ',', ts_ = ' ', decimal_ = '.';
+
+  bool in_polygon_ = false, poly_ok_ = false, poly_has_exterior_ = false, in_ring_ = false;
+  std::size_t poly_depth_ = 0;
+  int ring_role_ = 0;  // 1 exterior, 2 interior
+  std::string poly_id_;
+  std::vector<std::vector<Point3>> poly_rings_;
+  std::vector<Point3> ring_;
+
+  bool in_envelope_ = false, env_done_ = false;
+  int env_points_ = 0;
+};
+
+}  // namespace
+
+void read_citygml(const std::string& path, const CityGmlOptions& options, const MeshCallback& on_mesh,
+                  std::vector<Problem>& problems, SourceInfo& info) {
+  VSILFILE* fp = VSIFOpenL(path.c_str(), "rb");
+  if (!fp) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+  struct Closer {
+    VSILFILE* f;
+    ~Closer() { VSIFCloseL(f); }
+  } closer{fp};
+  Reader reader(path, options, on_mesh, problems, info);
+  for (;;) {
+    std::size_t n = reader.feed_from([&](void* buf, std::size_t cap) { return VSIFReadL(buf, 1, cap, fp); });
+    if (n == 0) break;
+  }
+  reader.finish();
+}
+
+void read_citygml_buffer(std::string_view xml, const std::string& name, const CityGmlOptions& options,
+                         const MeshCallback& on_mesh, std::vector<Problem>& problems, SourceInfo& info) {
+  Reader reader(name, options, on_mesh, problems, info);
+  std::size_t off = 0;
+  do {
+    std::size_t n = std::min<std::size_t>(kChunk, xml.size() - off);
+    reader.feed(xml.data() + off, n, false);
+    off += n;
+  } while (off < xml.size());
+  reader.feed(nullptr, 0, true);
+  reader.finish();
+}
+
+bool looks_like_citygml(std::string_view head) {
+  return head.find("http://www.opengis.net/citygml/") != std::string_view::npos &&
+         (head.find("CityModel") != std::string_view::npos || head.find("Building") != std::string_view::npos);
+}
+
+}  // namespace groundplan::gis

@@ -1,0 +1,287 @@
+// SPDX-License-Identifier: MIT
+// Working frame (issue 6): PROJ 9.1 objects behind a pimpl so that no caller sees proj.h.
+#include <groundplan/error.h>
+#include <groundplan/gis/crs.h>
+
+#include <proj.h>
+
+#include <cmath>
+#include <limits>
+
+namespace groundplan::gis {
+namespace {
+
+struct PjDeleter {
+  void operator()(PJ* p) const {
+    if (p) proj_destroy(p);
+  }
+};
+using PjPtr = std::unique_ptr<PJ, PjDeleter>;
+
+bool is_geographic(PJ_TYPE t) { return t == PJ_TYPE_GEOGRAPHIC_2D_CRS || t == PJ_TYPE_GEOGRAPHIC_3D_CRS; }
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+int utm_epsg_for(double lon_deg, double lat_deg) {
+  double lon = std::fmod(lon_deg + 180.0, 360.0);
+  if (lon < 0) lon += 360.0;
+  int zone = static_cast<int>(std::floor(lon / 6.0)) + 1;
+  if (zone > 60) zone = 60;
+  return (lat_deg >= 0 ? 32600 : 32700) + zone;
+}
+
+struct WorkingFrame::Impl {
+  PJ_CONTEXT* ctx = nullptr;
+  SrsName source;
+  CrsOptions options;
+  std::string file;
+  PjPtr src_h;          // horizontal part of the source CRS
+  PJ_TYPE src_type = PJ_TYPE_UNKNOWN;
+  bool src_known = false;
+  bool src_metric_projected = false;
+  bool swap_in = false;  // file writes the other axis order than the CRS's: swap x/y before PROJ
+  PjPtr working;
+  PjPtr op;              // source (as written) -> working (easting, northing)
+  bool identity = false;
+  bool decided = false;
+  WorkingCrs crs;
+  std::vector<std::string> notes;
+
+  ~Impl() {
+    op.reset();
+    working.reset();
+    src_h.reset();
+    if (ctx) proj_context_destroy(ctx);
+  }
+
+  std::string where() const { return file.empty() ? std::string() : file + ": "; }
+
+  PjPtr create(const std::string& def) const {
+    if (def.empty()) return nullptr;
+    return PjPtr(proj_create(ctx, def.c_str()));
+  }
+
+  /// Projected CRS whose first axis unit is the metre.
+  bool projected_metric(PJ* crs) const {
+    if (proj_get_type(crs) != PJ_TYPE_PROJECTED_CRS) return false;
+    PjPtr cs(proj_crs_get_coordinate_system(ctx, crs));
+    if (!cs) return false;
+    double factor = 0;
+    if (!proj_cs_get_axis_info(ctx, cs.get(), 0, nullptr, nullptr, nullptr, &factor, nullptr, nullptr, nullptr))
+      return false;
+    return std::fabs(factor - 1.0) < 1e-12;
+  }
+
+  /// Does the CRS put north (latitude/northing) first in its authority axis order?
+  bool north_first(PJ* crs) const {
+    PjPtr cs(proj_crs_get_coordinate_system(ctx, crs));
+    if (!cs) return false;
+    const char* dir = nullptr;
+    if (!proj_cs_get_axis_info(ctx, cs.get(), 0, nullptr, nullptr, &dir, nullptr, nullptr, nullptr, nullptr))
+      return false;
+    return dir && (std::string(dir) == "north" || std::string(dir) == "south");
+  }
+
+  void fill_crs(PJ* p, const std::string& definition) {
+    crs_known_from(p);
+    crs.definition = definition;
+  }
+  void crs_known_from(PJ* p) {
+    crs.known = true;
+    const char* opts[] = {"MULTILINE=NO", nullptr};
+    const char* wkt = proj_as_wkt(ctx, p, PJ_WKT2_2019, opts);
+    crs.wkt = wkt ? wkt : "";
+    const char* name = proj_get_name(p);
+    crs.name = name ? name : "";
+    const char* auth = proj_get_id_auth_name(p, 0);
+    const char* code = proj_get_id_code(p, 0);
+    crs.epsg = auth && code && std::string(auth) == "EPSG" ? std::atoi(code) : 0;
+  }
+
+  void make_op() {
+    // Input: as written (authority order for geographic sources, easting first for projected ones;
+    // swap_in handles files that say otherwise). Output: normalised, easting first.
+    PjPtr src_in(src_type == PJ_TYPE_PROJECTED_CRS ? proj_normalize_for_visualization(ctx, src_h.get())
+                                                   : proj_clone(ctx, src_h.get()));
+    PjPtr dst(proj_normalize_for_visualization(ctx, working.get()));
+    if (!src_in || !dst) throw Error(where() + "PROJ could not normalise the axis order of " + source.text);
+    op.reset(proj_create_crs_to_crs_from_pj(ctx, src_in.get(), dst.get(), nullptr, nullptr));
+    if (!op)
+      throw InputError(where() + "PROJ finds no transformation from " + source.text + " to " + crs.name +
+                       "; name another target with -t_srs");
+  }
+};
+
+WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& options, const std::string& file)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.ctx = proj_context_create();
+  if (!m.ctx) throw Error("cannot create a PROJ context");
+  proj_log_level(m.ctx, PJ_LOG_NONE);
+  m.options = options;
+  m.file = file;
+  m.source = parse_srs_name(source_srs);
+
+  if (!m.source.local) {
+    PjPtr src = m.create(m.source.definition);
+    if (!src) {
+      m.notes.push_back("srsName \"" + source_srs + "\" is not a CRS PROJ knows: coordinates kept as written, CRS unknown");
+    } else {
+      PJ_TYPE t = proj_get_type(src.get());
+      if (t == PJ_TYPE_COMPOUND_CRS) {
+        m.src_h.reset(proj_crs_get_sub_crs(m.ctx, src.get(), 0));
+      } else if (t == PJ_TYPE_BOUND_CRS) {
+        m.src_h.reset(proj_get_source_crs(m.ctx, src.get()));
+      } else {
+        m.src_h = std::move(src);
+      }
+      m.src_type = m.src_h ? proj_get_type(m.src_h.get()) : PJ_TYPE_UNKNOWN;
+      if (m.src_type == PJ_TYPE_PROJECTED_CRS || is_geographic(m.src_type)) {
+        m.src_known = true;
+        m.src_metric_projected = m.projected_metric(m.src_h.get());
+      } else {
+        m.notes.push_back("srsName \"" + source_srs + "\" is neither a projected nor a geographic CRS (" +
+                          (m.src_type == PJ_TYPE_GEOCENTRIC_CRS ? "geocentric" : "other") +
+                          "): coordinates kept as written, CRS unknown");
+        m.src_h.reset();
+      }
+    }
+  } else {
+    m.notes.push_back(source_srs.empty()
+                          ? "the file has no srsName: coordinates kept as written, CRS unknown"
+                          : "srsName \"" + source_srs + "\" is a CRS local to the file: coordinates kept as written, CRS unknown");
+  }
+
+  if (m.src_known) {
+    bool authority_north_first = is_geographic(m.src_type) && m.north_first(m.src_h.get());
+    switch (options.source_axis) {
+      case AxisOrder::Auto: m.swap_in = false; break;
+      case AxisOrder::EastNorth: m.swap_in = authority_north_first; break;
+      case AxisOrder::NorthEast: m.swap_in = !authority_north_first && is_geographic(m.src_type); break;
+    }
+    if (options.source_axis == AxisOrder::NorthEast && m.src_type == PJ_TYPE_PROJECTED_CRS) m.swap_in = true;
+  }
+
+  if (!options.target_srs.empty()) {
+    if (!m.src_known)
+      throw InvalidArgument(m.where() + "a target CRS (" + options.target_srs +
+                            ") was asked for, but the source CRS is unknown, so the data cannot be transformed");
+    SrsName t = parse_srs_name(options.target_srs);
+    m.working = m.create(t.definition);
+    if (m.working && proj_get_type(m.working.get()) == PJ_TYPE_COMPOUND_CRS)
+      m.working.reset(proj_crs_get_sub_crs(m.ctx, m.working.get(), 0));
+    if (!m.working || !m.projected_metric(m.working.get()))
+      throw InvalidArgument("target CRS \"" + options.target_srs +
+                            "\" is not a projected CRS in metres that PROJ knows (ground plans need a metric frame)");
+    m.fill_crs(m.working.get(), t.definition);
+  } else if (m.src_known && m.src_metric_projected) {
+    m.working.reset(proj_clone(m.ctx, m.src_h.get()));
+    m.crs_known_from(m.working.get());
+    m.crs.definition = m.crs.epsg ? "EPSG:" + std::to_string(m.crs.epsg) : m.source.definition;
+    m.identity = !m.swap_in;
+    m.decided = true;
+  } else if (!m.src_known) {
+    m.identity = true;
+    m.decided = true;
+  }
+  if (m.working && !m.decided) {
+    m.make_op();
+    m.decided = true;
+  }
+}
+
+WorkingFrame::~WorkingFrame() = default;
+WorkingFrame::WorkingFrame(WorkingFrame&&) noexcept = default;
+WorkingFrame& WorkingFrame::operator=(WorkingFrame&&) noexcept = default;
+
+void WorkingFrame::decide(double x, double y) {
+  Impl& m = *impl_;
+  if (m.decided) return;
+  // Here the source is known and geographic (or projected in feet): pick the UTM zone of (x, y).
+  if (m.swap_in) std::swap(x, y);
+  PjPtr src_in(proj_clone(m.ctx, m.src_h.get()));
+  PjPtr lonlat(proj_create(m.ctx, "OGC:CRS84"));
+  PjPtr to_ll(proj_create_crs_to_crs_from_pj(m.ctx, src_in.get(), lonlat.get(), nullptr, nullptr));
+  if (is_geographic(m.src_type)) {
+    // Degrees: hundreds of thousands means the label is wrong (projected numbers under a geographic name).
+    bool north_first = m.north_first(m.src_h.get());
+    double lat = north_first ? x : y, lon = north_first ? y : x;
+    if (!(std::fabs(lat) <= 90.0 && std::fabs(lon) <= 360.0))
+      throw InputError(m.where() + "srsName \"" + m.source.text + "\" names a geographic CRS (degrees, " +
+                       (north_first ? "latitude first" : "longitude first") + ") but the coordinates read " + fmt(x) +
+                       ", " + fmt(y) + ", which are no latitude/longitude: the srsName contradicts the data "
+                       "(projected coordinates under a geographic label?)");
+  }
+  PJ_COORD c = proj_coord(x, y, 0, 0);
+  PJ_COORD ll = to_ll ? proj_trans(to_ll.get(), PJ_FWD, c) : c;
+  if (!to_ll || !std::isfinite(ll.xy.x) || !std::isfinite(ll.xy.y) || std::fabs(ll.xy.y) > 90.0)
+    throw InputError(m.where() + "the point " + fmt(x) + ", " + fmt(y) + " is not a valid position in " + m.source.text +
+                     ": the srsName contradicts the data");
+  int epsg = utm_epsg_for(ll.xy.x, ll.xy.y);
+  m.working.reset(proj_create(m.ctx, ("EPSG:" + std::to_string(epsg)).c_str()));
+  if (!m.working) throw Error("PROJ does not know EPSG:" + std::to_string(epsg) + " (is proj.db installed?)");
+  m.fill_crs(m.working.get(), "EPSG:" + std::to_string(epsg));
+  m.notes.push_back("source CRS " + m.source.text + " is not projected in metres: working CRS is " + m.crs.name +
+                    " (EPSG:" + std::to_string(epsg) + "), the UTM zone of the data's centre");
+  m.make_op();
+  m.decided = true;
+}
+
+bool WorkingFrame::decided() const { return impl_->decided; }
+
+bool WorkingFrame::transform_point(double& x, double& y) const {
+  const Impl& m = *impl_;
+  if (m.identity) return true;
+  if (m.swap_in) std::swap(x, y);
+  if (!m.op) return true;  // projected metric source whose axes only needed swapping
+  PJ_COORD c = proj_trans(m.op.get(), PJ_FWD, proj_coord(x, y, 0, 0));
+  if (!std::isfinite(c.xy.x) || !std::isfinite(c.xy.y)) return false;
+  x = c.xy.x;
+  y = c.xy.y;
+  return true;
+}
+
+bool WorkingFrame::transform(Mesh& mesh, std::string* reason) {
+  Impl& m = *impl_;
+  if (m.identity || mesh.vertices.empty()) return true;
+  if (!m.decided) {
+    double lo_x = mesh.vertices[0].x, hi_x = lo_x, lo_y = mesh.vertices[0].y, hi_y = lo_y;
+    for (const Point3& p : mesh.vertices) {
+      lo_x = std::min(lo_x, p.x), hi_x = std::max(hi_x, p.x);
+      lo_y = std::min(lo_y, p.y), hi_y = std::max(hi_y, p.y);
+    }
+    decide((lo_x + hi_x) / 2, (lo_y + hi_y) / 2);
+  }
+  std::vector<Point3>& v = mesh.vertices;
+  if (m.swap_in)
+    for (Point3& p : v) std::swap(p.x, p.y);
+  if (!m.op) return true;
+  const std::size_t n = v.size();
+  proj_errno_reset(m.op.get());
+  proj_trans_generic(m.op.get(), PJ_FWD, &v[0].x, sizeof(Point3), n, &v[0].y, sizeof(Point3), n, nullptr, 0, 0,
+                     nullptr, 0, 0);
+  for (const Point3& p : v) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || std::fabs(p.x) > 1e15 || std::fabs(p.y) > 1e15) {
+      if (reason)
+        *reason = "a vertex cannot be transformed from " + m.source.text + " to " + m.crs.name +
+                  " (out of the CRS's domain, or the srsName does not fit the coordinates)";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool WorkingFrame::source_known() const { return impl_->src_known; }
+bool WorkingFrame::source_geographic() const { return is_geographic(impl_->src_type); }
+bool WorkingFrame::identity() const { return impl_->identity; }
+const SrsName& WorkingFrame::source() const { return impl_->source; }
+const WorkingCrs& WorkingFrame::working_crs() const { return impl_->crs; }
+const std::vector<std::string>& WorkingFrame::notes() const { return impl_->notes; }
+
+}  // namespace groundplan::gis
