@@ -1,0 +1,260 @@
+// SPDX-License-Identifier: MIT
+// groundplan: ogr2ogr's syntax with ground plans as the source. Our own flags are taken out here
+// (CLI11); everything else goes to GDAL's own ogr2ogr parser (GDALVectorTranslateOptionsNew), so every
+// ogr2ogr option behaves as users know it.
+#include "ogr_groundplan.h"
+#include "open_options.h"
+
+#include <groundplan/error.h>
+#include <groundplan/gis/geos_reference.h>
+#include <groundplan/gis/pipeline.h>
+
+#include <CLI/CLI.hpp>
+#include <gdal_utils.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace {
+
+using groundplan::gis::PipelineOptions;
+using groundplan::gis::PipelineResult;
+
+/// ogr2ogr options that take values (GDAL 3.6 ogr2ogr_lib.cpp), so that the positional arguments
+/// (destination, source, layer names) can be told apart from option values.
+int ogr2ogr_arity(const std::string& opt, const std::vector<std::string>& args, std::size_t i) {
+  static const std::set<std::string> one = {
+      "-f", "-of", "-dsco", "-lco", "-nln", "-nlt", "-t_srs", "-s_srs", "-a_srs", "-where", "-sql", "-dialect",
+      "-spat_srs", "-fid", "-select", "-geomfield", "-gt", "-simplify", "-segmentize", "-fieldTypeToString",
+      "-mapFieldType", "-fieldmap", "-zfield", "-oo", "-doo", "-mo", "-ct", "-clipsrcsql", "-clipsrclayer",
+      "-clipsrcwhere", "-clipdstsql", "-clipdstlayer", "-clipdstwhere", "-datelineoffset", "-limit", "-order",
+      "-a_coord_epoch", "-s_coord_epoch", "-t_coord_epoch", "-xyRes", "-zRes", "-mRes", "-dim", "-maxsubfields",
+      "-if", "--config", "--debug", "--optfile"};
+  if (opt == "-spat") return 4;
+  if (opt == "--config") return 2;
+  if (opt == "-gcp") {
+    // 4 numbers, and an optional fifth (elevation).
+    int n = 4;
+    if (i + 5 < args.size()) {
+      char* end = nullptr;
+      std::strtod(args[i + 5].c_str(), &end);
+      if (end && *end == '\0' && !args[i + 5].empty()) n = 5;
+    }
+    return n;
+  }
+  if (opt == "-clipsrc" || opt == "-clipdst") {
+    // Either one value (WKT, datasource, spat_extent) or xmin ymin xmax ymax.
+    if (i + 1 < args.size()) {
+      char* end = nullptr;
+      std::strtod(args[i + 1].c_str(), &end);
+      if (end && *end == '\0' && !args[i + 1].empty()) return 4;
+    }
+    return 1;
+  }
+  return one.count(opt) ? 1 : 0;
+}
+
+struct Ogr2ogrArgs {
+  std::vector<std::string> options;  // everything but the two datasource names
+  std::string dst, src;
+  bool progress = false;
+  bool quiet = false;
+  bool layer_named = false;
+  std::string format;
+};
+
+Ogr2ogrArgs split_ogr2ogr_args(const std::vector<std::string>& args) {
+  Ogr2ogrArgs out;
+  std::vector<std::string> positional;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.size() > 1 && a[0] == '-') {
+      const int n = ogr2ogr_arity(a, args, i);
+      if (i + static_cast<std::size_t>(n) >= args.size())
+        throw groundplan::InvalidArgument("option " + a + " needs " + std::to_string(n) + " value(s)");
+      if (a == "-progress") out.progress = true;
+      if (a == "-q" || a == "-quiet") out.quiet = true;
+      if (a == "-f" || a == "-of") out.format = args[i + 1];
+      out.options.push_back(a);
+      for (int k = 1; k <= n; ++k) out.options.push_back(args[i + static_cast<std::size_t>(k)]);
+      i += static_cast<std::size_t>(n);
+    } else {
+      positional.push_back(a);
+    }
+  }
+  if (positional.size() < 2)
+    throw groundplan::InvalidArgument(
+        "expected a destination and a source: groundplan [options] dst_datasource src_file [layer ...]");
+  out.dst = positional[0];
+  out.src = positional[1];
+  for (std::size_t i = 2; i < positional.size(); ++i) {
+    out.options.push_back(positional[i]);  // layer names, as ogr2ogr takes them
+    out.layer_named = true;
+  }
+  return out;
+}
+
+void print_problems(const PipelineResult& r) {
+  constexpr std::size_t kShown = 20;
+  for (std::size_t i = 0; i < r.problems.size() && i < kShown; ++i) {
+    const auto& p = r.problems[i];
+    std::fprintf(stderr, "groundplan: %s: %s%s%s: %s (%s)\n", p.file.c_str(), p.source_id.empty() ? "" : "building ",
+                 p.source_id.c_str(), p.source_id.empty() ? "" : "", p.reason.c_str(), p.code.c_str());
+  }
+  if (r.problems.size() > kShown)
+    std::fprintf(stderr, "groundplan: ... and %zu more problems: write the 'problems' layer to see them all\n",
+                 r.problems.size() - kShown);
+}
+
+std::size_t count_holes(const PipelineResult& r) {
+  std::size_t holes = 0;
+  for (const auto& p : r.plans) holes += p.polygon.holes.size();
+  return holes;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "groundplan: ground plans (the exact union of building footprints) from 3D city models.\n"
+      "Usage: groundplan [groundplan options] [ogr2ogr options] dst_datasource src_file_or_folder [layer ...]\n"
+      "Layers: ground_plans (default), footprints, problems. Every ogr2ogr option works (-f, -t_srs, -lco, -nln,\n"
+      "-where, -spat, -progress, -overwrite, -append, ...). Example:\n"
+      "  groundplan -f GPKG plans.gpkg city.gml ground_plans problems",
+      "groundplan"};
+  app.allow_extras();
+  app.set_version_flag("--version", std::string("groundplan ") + GROUNDPLAN_VERSION + " (GDAL " +
+                                        GDALVersionInfo("RELEASE_NAME") + ")");
+  double resolution = 0;
+  std::string device = "auto", footprints = "auto", stats_path;
+  int lod = -1;
+  bool verify = false;
+  app.add_option("--resolution", resolution, "Raster pixel in metres for blocks and seeds (0 = automatic); exact "
+                                              "result whatever the value")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--device", device, "auto|cpu|cuda: where blocks are rasterised");
+  app.add_option("--footprints", footprints, "auto|ground-surface|decompose: where footprints come from");
+  app.add_option("--lod", lod, "Level of detail to read (-1 = highest per building)")->check(CLI::Range(-1, 4));
+  app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
+  app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
+
+  // GDAL's own general options (--config, --debug, --formats ...) are handled by GDAL first.
+  GDALAllRegister();
+  groundplan::driver::register_driver();
+  argc = GDALGeneralCmdLineProcessor(argc, &argv, 0);
+  if (argc < 1) return 0;  // --formats and friends were answered
+
+  std::vector<std::string> rest;
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  rest = app.remaining();
+  if (rest.empty()) {
+    std::cout << app.help();
+    return 1;
+  }
+  const Ogr2ogrArgs ogr = split_ogr2ogr_args(rest);
+
+  PipelineOptions options;
+  options.inputs = {ogr.src};
+  options.union_params.resolution_m = resolution;
+  options.union_params.device = groundplan::gis::device_from_string(device);
+  options.footprints = groundplan::gis::footprint_mode_from_string(footprints);
+  options.lod = lod;
+
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  groundplan::Progress progress;
+  if (ogr.progress && !ogr.quiet)
+    progress = groundplan::Progress([](double f, const char* msg) {
+      return GDALTermProgress(f, msg, nullptr) != FALSE;
+    });
+  const PipelineResult result = groundplan::gis::run_pipeline(options, progress.sub(0, 1));
+
+  // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
+  auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
+                                                             result);
+  std::vector<std::string> vt_args = ogr.options;
+  if (!ogr.layer_named) vt_args.push_back("ground_plans");
+  CPLStringList vt_argv;
+  for (const auto& a : vt_args) vt_argv.AddString(a.c_str());
+  GDALVectorTranslateOptions* vt = GDALVectorTranslateOptionsNew(vt_argv.List(), nullptr);
+  if (!vt) {
+    delete ds;
+    return 1;  // GDAL already printed why
+  }
+  if (ogr.progress && !ogr.quiet) GDALVectorTranslateOptionsSetProgress(vt, GDALTermProgress, nullptr);
+  const auto t_write = clock::now();
+  GDALDatasetH src_h = GDALDataset::ToHandle(ds);
+  int usage_error = FALSE;
+  GDALDatasetH out = GDALVectorTranslate(ogr.dst.c_str(), nullptr, 1, &src_h, vt, &usage_error);
+  GDALVectorTranslateOptionsFree(vt);
+  const bool write_ok = out != nullptr;
+  if (out) GDALClose(out);
+  GDALClose(src_h);
+  const double write_s = std::chrono::duration<double>(clock::now() - t_write).count();
+  if (!write_ok) {
+    std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr.dst.c_str(),
+                 usage_error ? " (bad ogr2ogr options)" : "");
+    return 1;
+  }
+
+  const std::size_t holes = count_holes(result);
+  if (!ogr.quiet) {
+    std::printf("groundplan: read %zu buildings from %s (CRS %s)\n", result.buildings_read, ogr.src.c_str(),
+                result.crs_name.empty() ? "unknown" : result.crs_name.c_str());
+    std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %zu problems\n",
+                result.footprints.size(), result.plans.size(), holes, result.problems.size());
+    std::printf("groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, union %.2f s, write %.2f s)\n",
+                ogr.dst.c_str(), std::chrono::duration<double>(clock::now() - t0).count(), result.timings.read_s,
+                result.timings.footprints_s, result.timings.union_s, write_s);
+    print_problems(result);
+  }
+
+  int rc = 0;
+  nlohmann::json verify_json;
+  if (verify) {
+    const auto c = groundplan::gis::compare_with_geos(result.footprints, result.plans);
+    std::printf("groundplan: verify against GEOS UnaryUnion: %s: %s\n", c.matches() ? "MATCH" : "MISMATCH",
+                c.summary().c_str());
+    verify_json = {{"match", c.matches()},        {"symdiff_area_m2", c.symdiff_area}, {"area_m2", c.area_ours},
+                   {"area_geos_m2", c.area_geos}, {"polygons", c.polygons_ours},      {"polygons_geos", c.polygons_geos},
+                   {"holes", c.holes_ours},       {"holes_geos", c.holes_geos},        {"invalid", c.invalid_ours}};
+    if (!c.matches()) rc = 3;
+  }
+  if (!stats_path.empty()) {
+    nlohmann::json j;
+    j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
+                   {"ground_plans", result.plans.size()}, {"holes", holes},
+                   {"problems", result.problems.size()}};
+    j["timings_s"] = {{"read", result.timings.read_s}, {"footprints", result.timings.footprints_s},
+                      {"union", result.timings.union_s}, {"write", write_s}};
+    if (verify) j["verify"] = verify_json;
+    std::ofstream f(stats_path);
+    f << j.dump(2) << '\n';
+    if (!f) {
+      std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());
+      return 1;
+    }
+  }
+  return rc;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const int rc = run(argc, argv);
+    GDALDestroyDriverManager();
+    return rc;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "groundplan: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+#include "open_options.h"
+
+#include <groundplan/error.h>
+
+#include <cpl_string.h>
+
+#include <charconv>
+#include <cstring>
+
+namespace groundplan::driver {
+
+const char* open_option_list_xml() {
+  return "<OpenOptionList>"
+         "  <Option name='RESOLUTION' type='float' description='Raster pixel size in metres used to find blocks and "
+         "seeds (0 = automatic). The result is exact whatever the value.' default='0'/>"
+         "  <Option name='DEVICE' type='string-select' description='Where blocks are rasterised' default='AUTO'>"
+         "    <Value>AUTO</Value><Value>CPU</Value><Value>CUDA</Value>"
+         "  </Option>"
+         "  <Option name='FOOTPRINTS' type='string-select' description='Where footprints come from: explicit ground "
+         "geometry when present (AUTO), only explicit ground geometry, or surface decomposition' default='AUTO'>"
+         "    <Value>AUTO</Value><Value>GROUND-SURFACE</Value><Value>DECOMPOSE</Value>"
+         "  </Option>"
+         "  <Option name='LOD' type='int' description='Level of detail to read (-1 = highest available per "
+         "building)' default='-1'/>"
+         "  <Option name='T_SRS' type='string' description='Working CRS for the union (projected, metric); default: "
+         "the source CRS when projected, else the UTM zone of the data'/>"
+         "</OpenOptionList>";
+}
+
+std::vector<std::string> inputs_from_connection(const std::string& connection) {
+  const std::size_t n = std::strlen(kPrefix);
+  if (connection.size() < n || !EQUALN(connection.c_str(), kPrefix, n))
+    throw InvalidArgument("not a GroundPlan connection string (expected GROUNDPLAN:<file or folder>): " + connection);
+  std::vector<std::string> inputs;
+  const CPLStringList parts(CSLTokenizeString2(connection.c_str() + n, ",", CSLT_HONOURSTRINGS));
+  for (int i = 0; i < parts.size(); ++i)
+    if (*parts[i]) inputs.emplace_back(parts[i]);
+  if (inputs.empty()) throw InvalidArgument("GROUNDPLAN: names no input file");
+  return inputs;
+}
+
+namespace {
+double parse_double(const char* name, const char* value) {
+  double v = 0;
+  const char* end = value + std::strlen(value);
+  auto [ptr, ec] = std::from_chars(value, end, v);
+  if (ec != std::errc() || ptr != end)
+    throw InvalidArgument(std::string("open option ") + name + "=" + value + ": not a number");
+  return v;
+}
+}  // namespace
+
+gis::PipelineOptions pipeline_options_from(const std::string& connection, char** open_options) {
+  gis::PipelineOptions o;
+  o.inputs = inputs_from_connection(connection);
+  if (const char* v = CSLFetchNameValue(open_options, "RESOLUTION")) {
+    o.union_params.resolution_m = parse_double("RESOLUTION", v);
+    if (!(o.union_params.resolution_m >= 0))
+      throw InvalidArgument(std::string("open option RESOLUTION=") + v + ": must be >= 0 metres");
+  }
+  if (const char* v = CSLFetchNameValue(open_options, "DEVICE")) o.union_params.device = gis::device_from_string(v);
+  if (const char* v = CSLFetchNameValue(open_options, "FOOTPRINTS")) o.footprints = gis::footprint_mode_from_string(v);
+  if (const char* v = CSLFetchNameValue(open_options, "LOD")) {
+    const double lod = parse_double("LOD", v);
+    if (lod != static_cast<int>(lod) || lod < -1 || lod > 4)
+      throw InvalidArgument(std::string("open option LOD=") + v + ": must be -1 (highest) or 0..4");
+    o.lod = static_cast<int>(lod);
+  }
+  if (const char* v = CSLFetchNameValue(open_options, "T_SRS")) o.t_srs = v;
+  return o;
+}
+
+}  // namespace groundplan::driver

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// The whole job, file(s) in, ground plans out (DESIGN.md stages 1-6). Shared by the OGR driver and the
+// CLI so that both routes give the same plans.
+#include <groundplan/ground_plans.h>
+#include <groundplan/progress.h>
+#include <groundplan/types.h>
+
+#include <string>
+#include <vector>
+
+namespace groundplan::gis {
+
+enum class FootprintMode { Auto, GroundSurface, Decompose };
+
+struct PipelineOptions {
+  std::vector<std::string> inputs;  // files or folders (a folder: every CityGML file in it, sorted by name)
+  FootprintMode footprints = FootprintMode::Auto;
+  int lod = -1;                     // -1 = the highest LoD each building has
+  std::string t_srs;                // working CRS as the user names it (EPSG:n, WKT, PROJ string); empty = automatic
+  UnionParams union_params;
+};
+
+struct StageTimings {
+  double read_s = 0, footprints_s = 0, union_s = 0;
+};
+
+struct PipelineResult {
+  std::vector<Footprint> footprints;  // one per building (part) with a usable footprint
+  std::vector<GroundPlan> plans;      // members index `footprints`
+  std::vector<Problem> problems;      // every building not in a plan, and notes
+  std::size_t buildings_read = 0;     // building meshes (Building or BuildingPart) read from the inputs
+  std::string crs_wkt;                // working CRS (WKT2), empty when the input has no CRS
+  std::string crs_name;               // e.g. "EPSG:25833", for messages
+  StageTimings timings;
+};
+
+/// Runs read -> footprints -> union. Throws InputError when no input can be read at all, Cancelled
+/// when `progress` asks to stop. A bad building is a Problem, not an exception.
+PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
+
+const char* to_string(FootprintMode mode);
+FootprintMode footprint_mode_from_string(const std::string& s);  // throws InvalidArgument
+Device device_from_string(const std::string& s);                 // throws InvalidArgument
+
+}  // namespace groundplan::gis

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: MIT
+// read -> working frame -> footprints -> union, shared by the OGR driver and the CLI.
+#include <groundplan/error.h>
+#include <groundplan/footprint.h>
+#include <groundplan/gis/citygml.h>
+#include <groundplan/gis/crs.h>
+#include <groundplan/gis/pipeline.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+namespace groundplan::gis {
+namespace {
+
+namespace fs = std::filesystem;
+using clock_type = std::chrono::steady_clock;
+
+double seconds_since(clock_type::time_point t0) {
+  return std::chrono::duration<double>(clock_type::now() - t0).count();
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+bool is_citygml_name(const fs::path& p) {
+  const std::string ext = lower(p.extension().string());
+  return ext == ".gml" || ext == ".citygml" || ext == ".xml";
+}
+
+/// Files named by the inputs: a file as is, a folder as its CityGML files sorted by name.
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+  std::vector<std::string> files;
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(in, ec)) {
+      std::vector<std::string> found;
+      for (const auto& e : fs::directory_iterator(in, ec))
+        if (e.is_regular_file() && is_citygml_name(e.path())) found.push_back(e.path().string());
+      std::sort(found.begin(), found.end());
+      if (found.empty()) throw InputError(in + ": folder holds no CityGML file (*.gml, *.citygml, *.xml)");
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0) {
+      files.push_back(in);
+    } else {
+      throw InputError(in + ": no such file or folder");
+    }
+  }
+  return files;
+}
+
+FootprintSource to_core(FootprintMode m) {
+  switch (m) {
+    case FootprintMode::Auto: return FootprintSource::Auto;
+    case FootprintMode::GroundSurface: return FootprintSource::GroundSurface;
+    case FootprintMode::Decompose: return FootprintSource::Decompose;
+  }
+  return FootprintSource::Auto;
+}
+
+}  // namespace
+
+const char* to_string(FootprintMode mode) {
+  switch (mode) {
+    case FootprintMode::Auto: return "auto";
+    case FootprintMode::GroundSurface: return "ground-surface";
+    case FootprintMode::Decompose: return "decompose";
+  }
+  return "?";
+}
+
+FootprintMode footprint_mode_from_string(const std::string& s) {
+  const std::string l = lower(s);
+  if (l == "auto") return FootprintMode::Auto;
+  if (l == "ground-surface" || l == "ground_surface" || l == "groundsurface") return FootprintMode::GroundSurface;
+  if (l == "decompose") return FootprintMode::Decompose;
+  throw InvalidArgument("footprints: '" + s + "' is not one of auto, ground-surface, decompose");
+}
+
+Device device_from_string(const std::string& s) {
+  const std::string l = lower(s);
+  if (l == "auto") return Device::Auto;
+  if (l == "cpu") return Device::Cpu;
+  if (l == "cuda" || l == "gpu") return Device::Cuda;
+  throw InvalidArgument("device: '" + s + "' is not one of auto, cpu, cuda");
+}
+
+PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress) {
+  PipelineResult result;
+  const std::vector<std::string> files = expand_inputs(options.inputs);
+
+  CityGmlOptions read_options;
+  read_options.lod = options.lod;
+  FootprintParams footprint_params;
+  footprint_params.source = to_core(options.footprints);
+
+  // One working CRS for all inputs: the first file decides it (or -t_srs does); later files are
+  // transformed into it.
+  std::string working_definition = options.t_srs;
+  std::size_t files_failed = 0;
+  std::string first_failure;
+
+  const auto t_read = clock_type::now();
+  double footprint_s = 0;
+  for (std::size_t fi = 0; fi < files.size(); ++fi) {
+    const std::string& file = files[fi];
+    const Progress file_progress = progress.sub(0.6 * static_cast<double>(fi) / static_cast<double>(files.size()),
+                                                0.6 * static_cast<double>(fi + 1) / static_cast<double>(files.size()));
+    file_progress.report(0, "reading");
+    SourceInfo info;
+    std::unique_ptr<WorkingFrame> frame;
+    auto on_mesh = [&](Mesh&& mesh) {
+      ++result.buildings_read;
+      if (!frame) {
+        CrsOptions crs;
+        crs.target_srs = working_definition;
+        frame = std::make_unique<WorkingFrame>(info.srs_name, crs, file);
+      }
+      std::string reason;
+      if (!frame->transform(mesh, &reason)) {
+        result.problems.push_back({mesh.source_id, file, "georeference", "TRANSFORM_FAILED", reason});
+        return;
+      }
+      const auto t_fp = clock_type::now();
+      FootprintResult fp = make_footprint(mesh, footprint_params);
+      footprint_s += seconds_since(t_fp);
+      if (!fp.ok) {
+        result.problems.push_back({mesh.source_id, file, "footprint", fp.code, fp.reason});
+        return;
+      }
+      fp.footprint.source_file = file;
+      result.footprints.push_back(std::move(fp.footprint));
+      if ((result.buildings_read & 1023) == 0) file_progress.report(0.5, "reading");
+    };
+    try {
+      read_citygml(file, read_options, on_mesh, result.problems, info);
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const InputError& e) {
+      // One unreadable file does not stop the others; it is a problem of its own.
+      ++files_failed;
+      if (first_failure.empty()) first_failure = e.what();
+      result.problems.push_back({"", file, "read", "UNREADABLE_FILE", e.what()});
+    }
+    if (frame) {
+      for (const std::string& note : frame->notes()) result.problems.push_back({"", file, "georeference", "NOTE", note});
+      if (result.crs_wkt.empty() && frame->working_crs().known) {
+        result.crs_wkt = frame->working_crs().wkt;
+        result.crs_name = frame->working_crs().epsg ? "EPSG:" + std::to_string(frame->working_crs().epsg)
+                                                    : frame->working_crs().name;
+        if (working_definition.empty()) working_definition = frame->working_crs().definition;
+      }
+    }
+  }
+  if (files_failed == files.size()) throw InputError(first_failure);
+  result.timings.footprints_s = footprint_s;
+  result.timings.read_s = seconds_since(t_read) - footprint_s;
+
+  const auto t_union = clock_type::now();
+  result.plans = build_ground_plans(result.footprints, options.union_params, result.problems, progress.sub(0.6, 1.0));
+  result.timings.union_s = seconds_since(t_union);
+  progress.report(1.0, "done");
+  return result;
+}
+
+}  // namespace groundplan::gis

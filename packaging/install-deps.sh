@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs every Debian package that groundplan's build, tests and demo need. Idempotent and quiet;
+# run as root (or it re-runs itself with sudo) on Debian bookworm. Usage: bash packaging/install-deps.sh
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config
+  # GIS stack: GDAL (OGR driver, ogr2ogr parser, output formats), GEOS (reference union),
+  # PROJ (coordinate systems), GeographicLib (local frames of KML/COLLADA models)
+  libgdal-dev gdal-bin python3-gdal libgeos-dev libproj-dev proj-data proj-bin libgeographiclib-dev
+  # exact arithmetic (last rung of the precision ladder)
+  libmpfr-dev libgmp-dev
+  # formats: streaming XML (CityGML, KML, COLLADA), glTF
+  libexpat1-dev libtinygltf-dev
+  # CLI parsing, JSON (--stats), thread pool
+  libcli11-dev nlohmann-json3-dev libtbb-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev python3-pytest
+)
+
+if [ "$(id -u)" -ne 0 ]; then
+  exec sudo -E bash "$0" "$@"
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"
