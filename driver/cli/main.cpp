@@ -104,12 +104,23 @@ void print_problems(const PipelineResult& r) {
   constexpr std::size_t kShown = 20;
   for (std::size_t i = 0; i < r.problems.size() && i < kShown; ++i) {
     const auto& p = r.problems[i];
-    std::fprintf(stderr, "groundplan: %s: %s%s%s: %s (%s)\n", p.file.c_str(), p.source_id.empty() ? "" : "building ",
-                 p.source_id.c_str(), p.source_id.empty() ? "" : "", p.reason.c_str(), p.code.c_str());
+    if (p.source_id.empty())
+      std::fprintf(stderr, "groundplan: %s: %s: %s\n", p.file.c_str(), p.code == "NOTE" ? "note" : p.code.c_str(),
+                   p.reason.c_str());
+    else
+      std::fprintf(stderr, "groundplan: %s: building %s: %s (%s)\n", p.file.c_str(), p.source_id.c_str(),
+                   p.reason.c_str(), p.code.c_str());
   }
   if (r.problems.size() > kShown)
     std::fprintf(stderr, "groundplan: ... and %zu more problems: write the 'problems' layer to see them all\n",
                  r.problems.size() - kShown);
+}
+
+/// Problems proper, without notes (a CRS guess is worth saying but is no defect).
+std::size_t count_defects(const PipelineResult& r) {
+  std::size_t n = 0;
+  for (const auto& p : r.problems) n += p.code != "NOTE";
+  return n;
 }
 
 std::size_t count_holes(const PipelineResult& r) {
@@ -210,7 +221,7 @@ int run(int argc, char** argv) {
     std::printf("groundplan: read %zu buildings from %s (CRS %s)\n", result.buildings_read, ogr.src.c_str(),
                 result.crs_name.empty() ? "unknown" : result.crs_name.c_str());
     std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %zu problems\n",
-                result.footprints.size(), result.plans.size(), holes, result.problems.size());
+                result.footprints.size(), result.plans.size(), holes, count_defects(result));
     std::printf("groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, union %.2f s, write %.2f s)\n",
                 ogr.dst.c_str(), std::chrono::duration<double>(clock::now() - t0).count(), result.timings.read_s,
                 result.timings.footprints_s, result.timings.union_s, write_s);
@@ -232,7 +243,7 @@ int run(int argc, char** argv) {
     nlohmann::json j;
     j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                    {"ground_plans", result.plans.size()}, {"holes", holes},
-                   {"problems", result.problems.size()}};
+                   {"problems", count_defects(result)}};
     j["timings_s"] = {{"read", result.timings.read_s}, {"footprints", result.timings.footprints_s},
                       {"union", result.timings.union_s}, {"write", write_s}};
     if (verify) j["verify"] = verify_json;
