@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: MIT
+// The whole pipeline on real city models, checked against GEOS UnaryUnion through the C API
+// (gis/geosref): same polygons and holes, symmetric difference <= 1e-9 of the area, all valid, and
+// nothing lost (every building read is a footprint or a problem; every footprint is in a plan).
+#include <groundplan/error.h>
+#include <groundplan/gis/geos_reference.h>
+#include <groundplan/gis/pipeline.h>
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "test_support.h"
+
+namespace groundplan {
+namespace {
+
+struct Case {
+  const char* path;  // relative to sample_data/ or ../shared/data
+  bool shared;
+  std::size_t buildings;
+  std::size_t plans;
+  std::size_t holes;
+};
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.path; }
+
+class PipelineOnRealData : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PipelineOnRealData, MatchesGeosAndLosesNothing) {
+  const Case& c = GetParam();
+  gis::PipelineOptions options;
+  options.inputs = {c.shared ? test::shared_data(c.path) : test::sample_data(c.path)};
+  const gis::PipelineResult r = gis::run_pipeline(options);
+
+  EXPECT_EQ(r.buildings_read, c.buildings);
+  EXPECT_EQ(r.plans.size(), c.plans);
+  std::size_t holes = 0;
+  for (const auto& p : r.plans) holes += p.polygon.holes.size();
+  EXPECT_EQ(holes, c.holes);
+  EXPECT_FALSE(r.crs_wkt.empty());
+
+  const gis::GeosComparison cmp = gis::compare_with_geos(r.footprints, r.plans);
+  EXPECT_TRUE(cmp.matches(1e-9)) << cmp.summary();
+
+  // Nothing lost.
+  std::size_t building_problems = 0;
+  for (const auto& p : r.problems) building_problems += !p.source_id.empty() && p.code != "NOTE";
+  EXPECT_EQ(r.buildings_read, r.footprints.size() + building_problems);
+  std::set<std::uint32_t> members;
+  for (const auto& p : r.plans) members.insert(p.members.begin(), p.members.end());
+  std::set<std::string> union_problems;
+  for (const auto& p : r.problems)
+    if (p.stage == "union") union_problems.insert(p.source_id);
+  for (std::uint32_t i = 0; i < r.footprints.size(); ++i)
+    EXPECT_TRUE(members.count(i) || union_problems.count(r.footprints[i].source_id))
+        << "footprint " << r.footprints[i].source_id << " is in no plan and has no problem";
+}
+
+// Expected counts: sample_data/README.md (and GEOS UnaryUnion of the same footprints).
+INSTANTIATE_TEST_SUITE_P(
+    Samples, PipelineOnRealData,
+    ::testing::Values(Case{"plateau-niiza/53395404_bldg_6697_op.gml", false, 657, 650, 0},
+                      Case{"plateau-niiza/53392547_bldg_6697_op2.gml", false, 25, 23, 0},
+                      Case{"niedersachsen-lorup/LoD1_24065862_2_2021-01-25.gml", false, 104, 64, 6},
+                      Case{"tum-main-entrance/TUM-Main-Entrance.gml", false, 1, 1, 1},
+                      Case{"citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml", true, 61, 18, 39}));
+
+TEST(Pipeline, MissingFileNamesTheFile) {
+  gis::PipelineOptions options;
+  options.inputs = {"/nonexistent/city.gml"};
+  try {
+    gis::run_pipeline(options);
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/city.gml"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Pipeline, FolderOfTilesIsOneInput) {
+  gis::PipelineOptions options;
+  options.inputs = {test::shared_data("citygml1-niedersachsen-lod1-4tiles")};
+  const gis::PipelineResult r = gis::run_pipeline(options);
+  EXPECT_EQ(r.buildings_read, 408u + 259u - 0u) << "408 Buildings + 259 BuildingParts (SOURCE.txt)";
+  const gis::GeosComparison cmp = gis::compare_with_geos(r.footprints, r.plans);
+  EXPECT_TRUE(cmp.matches(1e-9)) << cmp.summary();
+}
+
+TEST(Pipeline, CancelStopsTheWork) {
+  gis::PipelineOptions options;
+  options.inputs = {test::sample_data("plateau-niiza/53395404_bldg_6697_op.gml")};
+  int calls = 0;
+  const Progress cancel_at_once([&](double, const char*) { return ++calls < 2; });
+  EXPECT_THROW(gis::run_pipeline(options, cancel_at_once), Cancelled);
+}
+
+}  // namespace
+}  // namespace groundplan
