@@ -5,6 +5,7 @@
 
 #include <proj.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -29,10 +30,12 @@ std::string fmt(double v) {
 }  // namespace
 
 int utm_epsg_for(double lon_deg, double lat_deg) {
-  double lon = std::fmod(lon_deg + 180.0, 360.0);
-  if (lon < 0) lon += 360.0;
-  int zone = static_cast<int>(std::floor(lon / 6.0)) + 1;
-  if (zone > 60) zone = 60;
+  double lon = lon_deg + 180.0;  // 0..360 for -180..180; 180°E itself is the east edge of zone 60
+  if (lon < 0 || lon > 360.0) {
+    lon = std::fmod(lon, 360.0);
+    if (lon < 0) lon += 360.0;
+  }
+  int zone = std::clamp(static_cast<int>(std::floor(lon / 6.0)) + 1, 1, 60);
   return (lat_deg >= 0 ? 32600 : 32700) + zone;
 }
 
