@@ -1,0 +1,311 @@
+// SPDX-License-Identifier: MIT
+// Adaptive-precision predicates (paper §6.3; Shewchuk 1997 for the rung-0 bound of the 2x2
+// determinant; Ozaki et al. 2016 / GEOS CGAlgorithmsDD for the double -> double-double ladder).
+#include "robust/predicates.h"
+
+#include <mpfr.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace groundplan::robust {
+namespace {
+
+constexpr double kU = 0x1p-53;                    // unit roundoff of double
+constexpr double kCcwErrBoundA = (3.0 + 16.0 * kU) * kU;  // Shewchuk, predicates.c
+constexpr double kDDBound = 32.0 * kU * kU;      // generous bound for one double-double 2x2 determinant
+
+// Counters of the calling thread (tests run predicates on their own thread).
+thread_local RungStats t_stats;
+
+inline void count(Family f, int rung) { ++t_stats.count[static_cast<int>(f)][rung]; }
+
+inline int sgn(double v) { return (v > 0) - (v < 0); }
+
+// ---- double-double ---------------------------------------------------------------------------
+struct DD {
+  double hi = 0, lo = 0;
+};
+
+inline DD two_sum(double a, double b) {
+  const double s = a + b;
+  const double bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+inline DD quick_two_sum(double a, double b) {
+  const double s = a + b;
+  return {s, b - (s - a)};
+}
+inline DD two_diff(double a, double b) {  // exact a - b
+  const double x = a - b;
+  const double bvirt = a - x;
+  const double avirt = x + bvirt;
+  return {x, (a - avirt) + (bvirt - b)};
+}
+inline void split(double a, double& hi, double& lo) {
+  constexpr double kSplitter = 134217729.0;  // 2^27 + 1
+  const double c = kSplitter * a;
+  const double abig = c - a;
+  hi = c - abig;
+  lo = a - hi;
+}
+inline DD two_prod(double a, double b) {  // exact a * b (Dekker; no FMA assumed)
+  const double p = a * b;
+  double ah, al, bh, bl;
+  split(a, ah, al);
+  split(b, bh, bl);
+  const double err = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+  return {p, err};
+}
+inline DD dd_mul(DD a, DD b) {
+  DD p = two_prod(a.hi, b.hi);
+  p.lo += a.hi * b.lo + a.lo * b.hi;
+  return quick_two_sum(p.hi, p.lo);
+}
+inline DD dd_sub(DD a, DD b) {
+  DD s = two_sum(a.hi, -b.hi);
+  const DD t = two_sum(a.lo, -b.lo);
+  s.lo += t.hi;
+  s = quick_two_sum(s.hi, s.lo);
+  s.lo += t.lo;
+  return quick_two_sum(s.hi, s.lo);
+}
+
+// ---- MPFR, exact: every operation's ternary value must be 0, else retry with more bits ----------
+class Mp {
+ public:
+  explicit Mp(mpfr_prec_t prec) { mpfr_init2(v_, prec); }
+  ~Mp() { mpfr_clear(v_); }
+  Mp(const Mp&) = delete;
+  Mp& operator=(const Mp&) = delete;
+  mpfr_ptr get() { return v_; }
+  mpfr_srcptr get() const { return v_; }
+
+ private:
+  mpfr_t v_;
+};
+
+/// (p1 - p0) x (q1 - q0) into out (precision >= 2 prec + 2); false if any step was inexact.
+bool mp_cross(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1, mpfr_prec_t prec, Mp& out) {
+  Mp dx1(prec), dy1(prec), dx2(prec), dy2(prec), t1(2 * prec), t2(2 * prec);
+  int inexact = 0;
+  inexact |= mpfr_set_d(dx1.get(), p1.x, MPFR_RNDN) | mpfr_sub_d(dx1.get(), dx1.get(), p0.x, MPFR_RNDN);
+  inexact |= mpfr_set_d(dy1.get(), p1.y, MPFR_RNDN) | mpfr_sub_d(dy1.get(), dy1.get(), p0.y, MPFR_RNDN);
+  inexact |= mpfr_set_d(dx2.get(), q1.x, MPFR_RNDN) | mpfr_sub_d(dx2.get(), dx2.get(), q0.x, MPFR_RNDN);
+  inexact |= mpfr_set_d(dy2.get(), q1.y, MPFR_RNDN) | mpfr_sub_d(dy2.get(), dy2.get(), q0.y, MPFR_RNDN);
+  inexact |= mpfr_mul(t1.get(), dx1.get(), dy2.get(), MPFR_RNDN);
+  inexact |= mpfr_mul(t2.get(), dy1.get(), dx2.get(), MPFR_RNDN);
+  inexact |= mpfr_sub(out.get(), t1.get(), t2.get(), MPFR_RNDN);
+  return inexact == 0;
+}
+
+constexpr mpfr_prec_t kMpPrecisions[] = {128, 512, 2200, 8800};  // 2200 bits cover any difference of doubles
+
+int mp_cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
+  for (mpfr_prec_t prec : kMpPrecisions) {
+    Mp out(2 * prec + 2);
+    if (mp_cross(p0, p1, q0, q1, prec, out)) return mpfr_sgn(out.get());
+  }
+  return 0;  // unreachable for finite input
+}
+
+// ---- rung 0/1 values with certified error bounds ---------------------------------------------
+struct Approx {
+  double v, err;
+};
+
+inline Approx cross_double(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
+  const double t1 = (p1.x - p0.x) * (q1.y - q0.y);
+  const double t2 = (p1.y - p0.y) * (q1.x - q0.x);
+  return {t1 - t2, kCcwErrBoundA * (std::fabs(t1) + std::fabs(t2))};
+}
+
+struct ApproxDD {
+  DD v;
+  double err;
+};
+
+inline ApproxDD cross_dd(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
+  const DD dx1 = two_diff(p1.x, p0.x), dy1 = two_diff(p1.y, p0.y);
+  const DD dx2 = two_diff(q1.x, q0.x), dy2 = two_diff(q1.y, q0.y);
+  const DD t1 = dd_mul(dx1, dy2), t2 = dd_mul(dy1, dx2);
+  return {dd_sub(t1, t2), kDDBound * (std::fabs(t1.hi) + std::fabs(t2.hi))};
+}
+
+}  // namespace
+
+RungStats rung_stats() { return t_stats; }
+void reset_rung_stats() { t_stats = RungStats{}; }
+
+int cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
+  const Approx a = cross_double(p0, p1, q0, q1);
+  if (a.v > a.err || -a.v > a.err) {
+    count(Family::Cross, 0);
+    return sgn(a.v);
+  }
+  // Exactly zero differences make the double result exact (common for axis-parallel walls).
+  if (a.err == 0) {
+    count(Family::Cross, 0);
+    return sgn(a.v);
+  }
+  const ApproxDD d = cross_dd(p0, p1, q0, q1);
+  const double dv = d.v.hi + d.v.lo;
+  if (dv > d.err || -dv > d.err) {
+    count(Family::Cross, 1);
+    return sgn(d.v.hi);
+  }
+  count(Family::Cross, 2);
+  return mp_cross_sign(p0, p1, q0, q1);
+}
+
+namespace {
+
+/// Exact sign of Oga*Ofb - Ofa*Ogb with O_s(P) = (s1 - s0) x (P - s0).
+int mp_crossing_num_sign(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1, const Point2& g0,
+                         const Point2& g1) {
+  for (mpfr_prec_t prec : kMpPrecisions) {
+    const mpfr_prec_t p2 = 2 * prec + 2;
+    Mp ofa(p2), ofb(p2), oga(p2), ogb(p2);
+    if (!mp_cross(f0, f1, f0, a, prec, ofa) || !mp_cross(f0, f1, f0, b, prec, ofb) ||
+        !mp_cross(g0, g1, g0, a, prec, oga) || !mp_cross(g0, g1, g0, b, prec, ogb))
+      continue;
+    Mp p1(2 * p2), p2m(2 * p2), num(2 * p2 + 2);
+    int inexact = mpfr_mul(p1.get(), oga.get(), ofb.get(), MPFR_RNDN);
+    inexact |= mpfr_mul(p2m.get(), ofa.get(), ogb.get(), MPFR_RNDN);
+    inexact |= mpfr_sub(num.get(), p1.get(), p2m.get(), MPFR_RNDN);
+    if (inexact == 0) return mpfr_sgn(num.get());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int compare_crossings(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1, const Point2& g0,
+                      const Point2& g1) {
+  // t_f - t_g = (Oga*Ofb - Ofa*Ogb) / ((Ofa - Ofb)(Oga - Ogb)), and Ofa - Ofb = (b - a) x (f1 - f0):
+  // valid for crossings anywhere on the line (events are reused on collinear segments).
+  const int sden = cross_sign(a, b, f0, f1) * cross_sign(a, b, g0, g1);
+  if (sden == 0) return 0;  // precondition violated: a line parallel to a->b
+  {
+    const Approx fa = cross_double(f0, f1, f0, a), fb = cross_double(f0, f1, f0, b);
+    const Approx ga = cross_double(g0, g1, g0, a), gb = cross_double(g0, g1, g0, b);
+    const double p1 = ga.v * fb.v, p2 = fa.v * gb.v;
+    const double num = p1 - p2;
+    double err = std::fabs(ga.v) * fb.err + std::fabs(fb.v) * ga.err + ga.err * fb.err + std::fabs(fa.v) * gb.err +
+                 std::fabs(gb.v) * fa.err + fa.err * gb.err;
+    err += kU * (std::fabs(p1) + std::fabs(p2)) + kU * std::fabs(num);
+    err *= 1.0 + 8.0 * kU;
+    if (num > err || -num > err) {
+      count(Family::CompareCrossings, 0);
+      return sgn(num) * sden;
+    }
+  }
+  {
+    const ApproxDD fa = cross_dd(f0, f1, f0, a), fb = cross_dd(f0, f1, f0, b);
+    const ApproxDD ga = cross_dd(g0, g1, g0, a), gb = cross_dd(g0, g1, g0, b);
+    const DD p1 = dd_mul(ga.v, fb.v), p2 = dd_mul(fa.v, gb.v);
+    const DD num = dd_sub(p1, p2);
+    const double afa = std::fabs(fa.v.hi) * (1 + 4 * kU), afb = std::fabs(fb.v.hi) * (1 + 4 * kU);
+    const double aga = std::fabs(ga.v.hi) * (1 + 4 * kU), agb = std::fabs(gb.v.hi) * (1 + 4 * kU);
+    double err = aga * fb.err + afb * ga.err + ga.err * fb.err + afa * gb.err + agb * fa.err + fa.err * gb.err;
+    err += kDDBound * (std::fabs(p1.hi) + std::fabs(p2.hi));
+    err *= 1.0 + 8.0 * kU;
+    const double nv = num.hi + num.lo;
+    if (nv > err || -nv > err) {
+      count(Family::CompareCrossings, 1);
+      return sgn(num.hi) * sden;
+    }
+  }
+  count(Family::CompareCrossings, 2);
+  return mp_crossing_num_sign(a, b, f0, f1, g0, g1) * sden;
+}
+
+std::vector<std::size_t> nearest_crossings(const Point2& a, const Point2& b, const std::vector<Segment>& segs) {
+  const std::size_t n = segs.size();
+  if (n <= 1) return n == 1 ? std::vector<std::size_t>{0} : std::vector<std::size_t>{};
+  struct Cand {
+    Approx va, vb;
+    int sa;  // exact sign of O(a): a is on this side, the crossing is where the sign flips
+  };
+  std::vector<Cand> c(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    c[i].va = cross_double(segs[i].p0, segs[i].p1, segs[i].p0, a);
+    c[i].vb = cross_double(segs[i].p0, segs[i].p1, segs[i].p0, b);
+    c[i].sa = cross_sign(segs[i].p0, segs[i].p1, segs[i].p0, a);
+  }
+  std::vector<std::size_t> s(n);
+  for (std::size_t i = 0; i < n; ++i) s[i] = i;
+  std::vector<std::size_t> inv, vis, unc;
+  double lo = 0, hi = 1;
+  bool exact_scan = false;
+  for (int iter = 0; iter < 60 && s.size() > 1; ++iter) {
+    const double tau = 0.5 * (lo + hi);  // dyadic: 1 - tau is exact
+    inv.clear();
+    vis.clear();
+    unc.clear();
+    for (std::size_t i : s) {
+      const Cand& k = c[i];
+      const double w0 = (1.0 - tau) * k.va.v, w1 = tau * k.vb.v;
+      const double val = w0 + w1;
+      const double err = ((1.0 - tau) * k.va.err + tau * k.vb.err + 2 * kU * (std::fabs(w0) + std::fabs(w1)) +
+                          kU * std::fabs(val)) *
+                         (1.0 + 8.0 * kU);
+      if (val > err || -val > err) {
+        count(Family::Visibility, 0);
+        (sgn(val) == k.sa ? vis : inv).push_back(i);  // still on a's side: q is visible, crossing after q
+      } else {
+        unc.push_back(i);
+      }
+    }
+    if (!unc.empty()) {
+      if (!inv.empty()) {
+        inv.insert(inv.end(), unc.begin(), unc.end());
+        s.swap(inv);
+      }
+      exact_scan = true;
+      break;
+    }
+    if (!inv.empty()) {
+      s.swap(inv);
+      hi = tau;
+    } else {
+      s.swap(vis);
+      lo = tau;
+    }
+  }
+  if (s.size() > 1 || exact_scan) {
+    // The interval cannot separate these: exact comparisons (each escalates only if it must).
+    std::vector<std::size_t> best{s[0]};
+    for (std::size_t k = 1; k < s.size(); ++k) {
+      const std::size_t i = s[k], j = best[0];
+      const int cmp = compare_crossings(a, b, segs[i].p0, segs[i].p1, segs[j].p0, segs[j].p1);
+      if (cmp < 0) {
+        best.assign(1, i);
+      } else if (cmp == 0) {
+        best.push_back(i);
+      }
+    }
+    std::sort(best.begin(), best.end());
+    return best;
+  }
+  return s;
+}
+
+Point2 crossing_point(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1) {
+  using L = long double;
+  const L fx = L(f1.x) - L(f0.x), fy = L(f1.y) - L(f0.y);
+  const L oa = fx * (L(a.y) - L(f0.y)) - fy * (L(a.x) - L(f0.x));
+  const L ob = fx * (L(b.y) - L(f0.y)) - fy * (L(b.x) - L(f0.x));
+  const L t = oa / (oa - ob);
+  Point2 p{static_cast<double>(L(a.x) + t * (L(b.x) - L(a.x))), static_cast<double>(L(a.y) + t * (L(b.y) - L(a.y)))};
+  // The exact point lies in both segments' bounding boxes: clamp into their intersection.
+  const double xlo = std::max(std::min(a.x, b.x), std::min(f0.x, f1.x));
+  const double xhi = std::min(std::max(a.x, b.x), std::max(f0.x, f1.x));
+  const double ylo = std::max(std::min(a.y, b.y), std::min(f0.y, f1.y));
+  const double yhi = std::min(std::max(a.y, b.y), std::max(f0.y, f1.y));
+  p.x = std::clamp(p.x, xlo, std::max(xlo, xhi));
+  p.y = std::clamp(p.y, ylo, std::max(ylo, yhi));
+  return p;
+}
+
+}  // namespace groundplan::robust

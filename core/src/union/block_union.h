@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// The union of one block of footprints by online boundary evaluation (paper §6), with the exact
+// completeness check that replaces pixel resolution (paper §3 "Update", issue 3).
+#include <groundplan/types.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace groundplan::detail {
+
+struct BlockStats {
+  std::uint64_t walk_steps = 0;      // boundary edges discovered (§6.2 iterations)
+  std::uint64_t rings_traced = 0;    // closed boundary walks
+  std::uint64_t seeds_from_check = 0;// walks started by the completeness check (holes, separate rings)
+  std::uint64_t edges_checked = 0;   // input edges the completeness check had to examine exactly
+};
+
+struct BlockResult {
+  std::vector<GroundPlan> plans;
+  std::vector<Problem> problems;
+  BlockStats stats;
+};
+
+/// The exact union of the footprints `members` (indices into `footprints`): one GroundPlan per
+/// connected polygon, outer ring counter-clockwise, holes clockwise. Each input polygon counts by
+/// the even-odd rule over its rings (its valid repair, as GEOS MakeValid gives it). Throws
+/// TopologyError if a boundary walk does not close (never expected: every decision is exact).
+BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members);
+
+}  // namespace groundplan::detail

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: MIT
+// build_ground_plans: Algorithm 3.1 of the paper. Blocks from the raster backend (§5), then every
+// block on its own (they are independent: tbb::parallel_for over blocks, largest first).
+#include <groundplan/error.h>
+#include <groundplan/ground_plans.h>
+#include <groundplan/raster_backend.h>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <thread>
+
+#include "robust/predicates.h"
+#include "union/block_union.h"
+
+namespace groundplan {
+namespace {
+
+/// True if some ring of some polygon has three non-collinear vertices (exact): the even-odd region
+/// can only have area then.
+bool has_area(const Footprint& f) {
+  for (const Polygon& p : f.polygons) {
+    auto ring = [](const Ring& r) {
+      std::size_t i0 = r.size();
+      for (std::size_t i = 0; i < r.size(); ++i)
+        if (std::isfinite(r[i].x) && std::isfinite(r[i].y)) {
+          i0 = i;
+          break;
+        }
+      if (i0 == r.size()) return false;
+      std::size_t i1 = r.size();
+      for (std::size_t i = i0 + 1; i < r.size(); ++i)
+        if (std::isfinite(r[i].x) && std::isfinite(r[i].y) && !(r[i] == r[i0])) {
+          i1 = i;
+          break;
+        }
+      if (i1 == r.size()) return false;
+      for (std::size_t i = i1 + 1; i < r.size(); ++i)
+        if (std::isfinite(r[i].x) && std::isfinite(r[i].y) && robust::orient(r[i0], r[i1], r[i]) != 0) return true;
+      return false;
+    };
+    if (ring(p.outer)) return true;
+    for (const Ring& h : p.holes)
+      if (ring(h)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footprints, const UnionParams& params,
+                                           std::vector<Problem>& problems, const Progress& progress) {
+  if (params.resolution_m < 0 || !std::isfinite(params.resolution_m))
+    throw InvalidArgument("resolution_m must be >= 0 (0 = automatic), got " + std::to_string(params.resolution_m));
+  if (params.threads < 0) throw InvalidArgument("threads must be >= 0 (0 = all cores)");
+  std::unique_ptr<RasterBackend> backend = make_raster_backend(params.device);
+
+  // Footprints without area take no part; each is reported (nothing is dropped silently).
+  std::vector<Footprint> const* src = &footprints;
+  std::vector<char> usable(footprints.size(), 0);
+  for (std::size_t i = 0; i < footprints.size(); ++i) {
+    usable[i] = has_area(footprints[i]);
+    if (!usable[i])
+      problems.push_back(Problem{footprints[i].source_id, footprints[i].source_file, "union", "NO_AREA",
+                                 "the footprint has no area (fewer than three non-collinear points): not in any plan"});
+  }
+  FootprintSet all = make_footprint_set(*src);
+  FootprintSet fps;
+  fps.footprints = src;
+  for (std::size_t k = 0; k < all.indices.size(); ++k) {
+    if (!usable[all.indices[k]]) continue;
+    fps.indices.push_back(all.indices[k]);
+    fps.boxes.push_back(all.boxes[k]);
+  }
+  const PixelGrid grid = make_pixel_grid(fps, params.resolution_m);
+  std::vector<Block> blocks = backend->find_blocks(fps, grid, progress.sub(0.0, 0.1));
+
+  // Largest blocks first, so that one big block does not finish last on one core.
+  std::vector<std::size_t> order(blocks.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return blocks[a].footprints.size() > blocks[b].footprints.size(); });
+
+  std::vector<detail::BlockResult> results(blocks.size());
+  std::atomic<std::size_t> done{0};
+  const std::thread::id caller = std::this_thread::get_id();
+  const Progress stage = progress.sub(0.1, 1.0);
+  auto one = [&](std::size_t oi) {
+    const std::size_t bi = order[oi];
+    try {
+      results[bi] = detail::union_block(*src, blocks[bi].footprints);
+    } catch (const TopologyError& e) {
+      detail::BlockResult r;
+      for (std::uint32_t fi : blocks[bi].footprints)
+        r.problems.push_back(Problem{footprints[fi].source_id, footprints[fi].source_file, "union", "UNION_FAILED",
+                                     std::string("the union of this footprint's block failed: ") + e.what()});
+      results[bi] = std::move(r);
+    }
+    const std::size_t d = ++done;
+    if (progress && std::this_thread::get_id() == caller && (d % 64 == 0 || d == blocks.size()))
+      stage.report(static_cast<double>(d) / static_cast<double>(blocks.size()), "union of blocks");
+  };
+  const int threads = params.threads > 0 ? params.threads : tbb::this_task_arena::max_concurrency();
+  if (threads == 1 || blocks.size() <= 1) {
+    for (std::size_t oi = 0; oi < blocks.size(); ++oi) one(oi);
+  } else {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t oi = r.begin(); oi != r.end(); ++oi) one(oi);
+                        });
+    });
+  }
+  std::vector<GroundPlan> plans;
+  for (detail::BlockResult& r : results) {
+    for (GroundPlan& g : r.plans) plans.push_back(std::move(g));
+    for (Problem& p : r.problems) problems.push_back(std::move(p));
+  }
+  progress.report(1.0, "ground plans");
+  return plans;
+}
+
+}  // namespace groundplan
