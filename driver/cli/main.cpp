@@ -4,6 +4,7 @@
 // ogr2ogr option behaves as users know it.
 #include "ogr_groundplan.h"
 #include "open_options.h"
+#include "preview.h"
 
 #include <groundplan/error.h>
 #include <groundplan/gis/geos_reference.h>
@@ -13,7 +14,10 @@
 #include <gdal_utils.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -62,6 +66,7 @@ int ogr2ogr_arity(const std::string& opt, const std::vector<std::string>& args, 
 
 struct Ogr2ogrArgs {
   std::vector<std::string> options;  // everything but the two datasource names
+  std::vector<std::string> layers;   // layer names given after the source
   std::string dst, src;
   bool progress = false;
   bool quiet = false;
@@ -95,9 +100,42 @@ Ogr2ogrArgs split_ogr2ogr_args(const std::vector<std::string>& args) {
   out.src = positional[1];
   for (std::size_t i = 2; i < positional.size(); ++i) {
     out.options.push_back(positional[i]);  // layer names, as ogr2ogr takes them
+    out.layers.push_back(positional[i]);
     out.layer_named = true;
   }
   return out;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// True when the output goes to DBF files (Shapefile): string fields hold at most 254 characters.
+bool writes_dbf(const Ogr2ogrArgs& ogr) {
+  if (!ogr.format.empty()) return lower(ogr.format) == "esri shapefile";
+  const std::string ext = lower(std::filesystem::path(ogr.dst).extension().string());
+  return ext == ".shp" || ext == ".dbf";
+}
+
+/// Runs GDAL's ogr2ogr on `src` with `args`; false (GDAL has printed why) on failure.
+bool vector_translate(const std::string& dst, GDALDatasetH src, const std::vector<std::string>& args, bool progress,
+                      int* usage_error) {
+  CPLStringList argv;
+  for (const auto& a : args) argv.AddString(a.c_str());
+  GDALVectorTranslateOptions* vt = GDALVectorTranslateOptionsNew(argv.List(), nullptr);
+  if (!vt) {
+    *usage_error = TRUE;
+    return false;
+  }
+  if (progress) GDALVectorTranslateOptionsSetProgress(vt, GDALTermProgress, nullptr);
+  GDALDatasetH out = GDALVectorTranslate(dst.c_str(), nullptr, 1, &src, vt, usage_error);
+  GDALVectorTranslateOptionsFree(vt);
+  if (!out) return false;
+  // Closing flushes: an error here (disk full ...) is a failure too.
+  CPLErrorReset();
+  GDALClose(out);
+  return CPLGetLastErrorType() < CE_Failure;
 }
 
 void print_problems(const PipelineResult& r) {
@@ -141,7 +179,7 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", std::string("groundplan ") + GROUNDPLAN_VERSION + " (GDAL " +
                                         GDALVersionInfo("RELEASE_NAME") + ")");
   double resolution = 0;
-  std::string device = "auto", footprints = "auto", stats_path;
+  std::string device = "auto", footprints = "auto", stats_path, preview_path;
   int lod = -1;
   bool verify = false;
   app.add_option("--resolution", resolution, "Raster pixel in metres for blocks and seeds (0 = automatic); exact "
@@ -152,6 +190,7 @@ int run(int argc, char** argv) {
   app.add_option("--lod", lod, "Level of detail to read (-1 = highest per building)")->check(CLI::Range(-1, 4));
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
+  app.add_option("--preview", preview_path, "Write a PNG map of the plans (holes open, problem buildings in red)");
 
   // GDAL's own general options (--config, --debug, --formats ...) are handled by GDAL first.
   GDALAllRegister();
@@ -189,25 +228,34 @@ int run(int argc, char** argv) {
   const PipelineResult result = groundplan::gis::run_pipeline(options, progress.sub(0, 1));
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
+  const bool dbf = writes_dbf(ogr);
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
-                                                             result);
+                                                             result, dbf ? 254 : 0);
+  GDALDatasetH src_h = GDALDataset::ToHandle(ds);
   std::vector<std::string> vt_args = ogr.options;
   if (!ogr.layer_named) vt_args.push_back("ground_plans");
-  CPLStringList vt_argv;
-  for (const auto& a : vt_args) vt_argv.AddString(a.c_str());
-  GDALVectorTranslateOptions* vt = GDALVectorTranslateOptionsNew(vt_argv.List(), nullptr);
-  if (!vt) {
-    delete ds;
-    return 1;  // GDAL already printed why
-  }
-  if (ogr.progress && !ogr.quiet) GDALVectorTranslateOptionsSetProgress(vt, GDALTermProgress, nullptr);
   const auto t_write = clock::now();
-  GDALDatasetH src_h = GDALDataset::ToHandle(ds);
   int usage_error = FALSE;
-  GDALDatasetH out = GDALVectorTranslate(ogr.dst.c_str(), nullptr, 1, &src_h, vt, &usage_error);
-  GDALVectorTranslateOptionsFree(vt);
-  const bool write_ok = out != nullptr;
-  if (out) GDALClose(out);
+  bool write_ok = vector_translate(ogr.dst, src_h, vt_args, ogr.progress && !ogr.quiet, &usage_error);
+
+  // DBF fields hold 254 characters: cut lists are marked "...(+N)" and the full lists go beside them.
+  std::string members_note;
+  const bool members_named =
+      std::find(ogr.layers.begin(), ogr.layers.end(), std::string("plan_members")) != ogr.layers.end();
+  if (write_ok && dbf && ds->id_lists_cut() && !members_named) {
+    std::filesystem::path dst(ogr.dst);
+    const bool single_file = lower(dst.extension().string()) == ".shp";
+    const std::string dir = single_file ? (dst.has_parent_path() ? dst.parent_path().string() : ".") : ogr.dst;
+    const std::string name = (single_file ? dst.stem().string() : std::string("ground_plans")) + "_members";
+    std::vector<std::string> args = {"-f", "ESRI Shapefile", "-nln", name, "plan_members"};
+    if (std::find(ogr.options.begin(), ogr.options.end(), "-overwrite") != ogr.options.end())
+      args.insert(args.begin(), "-overwrite");
+    write_ok = vector_translate(dir, src_h, args, false, &usage_error);
+    members_note = std::to_string(ds->id_lists_cut()) +
+                   " plans list more building ids than a DBF field holds (254 characters): their building_ids end "
+                   "in '...(+N)'; the full lists are in " +
+                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id)";
+  }
   GDALClose(src_h);
   const double write_s = std::chrono::duration<double>(clock::now() - t_write).count();
   if (!write_ok) {
@@ -215,6 +263,7 @@ int run(int argc, char** argv) {
                  usage_error ? " (bad ogr2ogr options)" : "");
     return 1;
   }
+  if (!members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", members_note.c_str());
 
   const std::size_t holes = count_holes(result);
   if (!ogr.quiet) {
@@ -227,6 +276,8 @@ int run(int argc, char** argv) {
                 result.timings.footprints_s, result.timings.union_s, write_s);
     print_problems(result);
   }
+
+  if (!preview_path.empty()) groundplan::cli::write_preview_png(result, preview_path);
 
   int rc = 0;
   nlohmann::json verify_json;

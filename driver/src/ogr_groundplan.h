@@ -42,7 +42,14 @@ class OGRGroundPlanLayer final : public OGRLayer {
 class OGRGroundPlanDataSource final : public GDALDataset {
  public:
   /// Builds the layers from a pipeline result (the CLI calls this after running the pipeline itself).
-  OGRGroundPlanDataSource(const std::string& description, const gis::PipelineResult& result);
+  /// `max_id_list_chars` > 0 cuts building_ids to that many characters at a comma, ending in
+  /// "...(+N)" so the cut is visible (DBF fields hold 254); the full lists are always in plan_members.
+  /// It also names fields within DBF's 10 characters: building_ids -> bldg_ids, source_file -> src_file.
+  OGRGroundPlanDataSource(const std::string& description, const gis::PipelineResult& result,
+                          std::size_t max_id_list_chars = 0);
+
+  /// Plans whose building_ids were cut (see max_id_list_chars).
+  std::size_t id_lists_cut() const { return id_lists_cut_; }
 
   int GetLayerCount() override { return static_cast<int>(layers_.size()); }
   OGRLayer* GetLayer(int i) override;
@@ -55,6 +62,7 @@ class OGRGroundPlanDataSource final : public GDALDataset {
  private:
   std::vector<std::unique_ptr<OGRGroundPlanLayer>> layers_;
   OGRSpatialReference srs_;
+  std::size_t id_lists_cut_ = 0;
 };
 
 /// Registers the driver with GDAL (idempotent). The plugin's RegisterOGRGroundPlan calls it.

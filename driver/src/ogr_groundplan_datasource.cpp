@@ -36,9 +36,26 @@ void add_field(OGRFeatureDefn* defn, const char* name, OGRFieldType type, int wi
   defn->AddFieldDefn(&f);
 }
 
+/// "a,b,c,d" cut to at most `max` characters at a comma, ending in ",...(+N)" with N ids left out.
+std::string cut_id_list(const std::string& ids, std::size_t count, std::size_t max) {
+  if (max == 0 || ids.size() <= max) return ids;
+  std::size_t kept = 0, end = 0;
+  for (std::size_t pos = 0; pos != std::string::npos;) {
+    const std::size_t next = ids.find(',', pos);
+    const std::size_t stop = next == std::string::npos ? ids.size() : next;
+    const std::string tail = ",...(+" + std::to_string(count - kept - 1) + ")";
+    if (stop + tail.size() > max) break;
+    end = stop;
+    ++kept;
+    pos = next == std::string::npos ? next : next + 1;
+  }
+  return ids.substr(0, end) + (kept ? "," : "") + "...(+" + std::to_string(count - kept) + ")";
+}
+
 }  // namespace
 
-OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description, const gis::PipelineResult& result) {
+OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description, const gis::PipelineResult& result,
+                                                 std::size_t max_id_list_chars) {
   SetDescription(description.c_str());
   const OGRSpatialReference* srs = nullptr;
   if (!result.crs_wkt.empty() && srs_.importFromWkt(result.crs_wkt.c_str()) == OGRERR_NONE) {
@@ -56,7 +73,11 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   add_field(plans->defn(), "area_m2", OFTReal);
   add_field(plans->defn(), "min_z", OFTReal);
   add_field(plans->defn(), "max_z", OFTReal);
-  add_field(plans->defn(), "building_ids", OFTString);
+  // DBF field names hold 10 characters: say what GDAL would otherwise launder with a warning.
+  const bool dbf = max_id_list_chars > 0;
+  const char* ids_field = dbf ? "bldg_ids" : "building_ids";
+  const char* file_field = dbf ? "src_file" : "source_file";
+  add_field(plans->defn(), ids_field, OFTString);
   for (std::size_t i = 0; i < result.plans.size(); ++i) {
     const GroundPlan& gp = result.plans[i];
     auto f = std::make_unique<OGRFeature>(plans->defn());
@@ -79,7 +100,9 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
       f->SetField("min_z", zmin);
       f->SetField("max_z", zmax);
     }
-    f->SetField("building_ids", ids.c_str());
+    const std::string shown = cut_id_list(ids, gp.members.size(), max_id_list_chars);
+    id_lists_cut_ += shown.size() != ids.size();
+    f->SetField(ids_field, shown.c_str());
     f->SetGeometryDirectly(to_ogr_polygon(gp.polygon));
     plans->add(std::move(f));
   }
@@ -87,7 +110,8 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   auto footprints = std::make_unique<OGRGroundPlanLayer>("footprints", wkbMultiPolygon, srs);
   add_field(footprints->defn(), "fp_id", OFTInteger64);
   add_field(footprints->defn(), "source_id", OFTString);
-  add_field(footprints->defn(), "source_file", OFTString);
+  add_field(footprints->defn(), file_field, OFTString);
+  add_field(footprints->defn(), "method", OFTString);
   add_field(footprints->defn(), "gp_id", OFTInteger64);
   add_field(footprints->defn(), "min_z", OFTReal);
   add_field(footprints->defn(), "max_z", OFTReal);
@@ -95,7 +119,8 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
     auto f = std::make_unique<OGRFeature>(footprints->defn());
     f->SetField("fp_id", static_cast<GIntBig>(i + 1));
     f->SetField("source_id", fps[i].source_id.c_str());
-    f->SetField("source_file", fps[i].source_file.c_str());
+    f->SetField(file_field, fps[i].source_file.c_str());
+    f->SetField("method", fps[i].method.c_str());
     if (plan_of[i]) f->SetField("gp_id", plan_of[i]);
     f->SetField("min_z", fps[i].min_z);
     f->SetField("max_z", fps[i].max_z);
@@ -103,6 +128,22 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
     for (const Polygon& p : fps[i].polygons) mp->addGeometryDirectly(to_ogr_polygon(p));
     f->SetGeometryDirectly(mp);
     footprints->add(std::move(f));
+  }
+
+  // One row per (plan, member): the full lists in a form every format holds.
+  auto members = std::make_unique<OGRGroundPlanLayer>("plan_members", wkbNone, nullptr);
+  add_field(members->defn(), "gp_id", OFTInteger64);
+  add_field(members->defn(), "fp_id", OFTInteger64);
+  add_field(members->defn(), "source_id", OFTString);
+  for (std::size_t i = 0; i < result.plans.size(); ++i) {
+    for (std::uint32_t m : result.plans[i].members) {
+      if (m >= fps.size()) continue;
+      auto f = std::make_unique<OGRFeature>(members->defn());
+      f->SetField("gp_id", static_cast<GIntBig>(i + 1));
+      f->SetField("fp_id", static_cast<GIntBig>(m + 1));
+      f->SetField("source_id", fps[m].source_id.c_str());
+      members->add(std::move(f));
+    }
   }
 
   auto problems = std::make_unique<OGRGroundPlanLayer>("problems", wkbNone, nullptr);
@@ -120,6 +161,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   layers_.push_back(std::move(plans));
   layers_.push_back(std::move(footprints));
   layers_.push_back(std::move(problems));
+  layers_.push_back(std::move(members));
 }
 
 OGRLayer* OGRGroundPlanDataSource::GetLayer(int i) {

@@ -133,6 +133,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
         return;
       }
       fp.footprint.source_file = file;
+      fp.footprint.method = to_string(fp.method);
       result.footprints.push_back(std::move(fp.footprint));
       if ((result.buildings_read & 1023) == 0) file_progress.report(0.5, "reading");
     };

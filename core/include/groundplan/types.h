@@ -30,6 +30,7 @@ struct Footprint {
   std::vector<Polygon> polygons;  // a building may stand on several disjoint ground polygons
   std::string source_id;          // gml:id, KML Placemark id, glTF node name ...
   std::string source_file;
+  std::string method;             // how it was found: to_string(FootprintMethod), e.g. "ground-surface"
   double min_z = 0;               // lowest / highest vertex height of the source mesh (metres)
   double max_z = 0;
 };
