@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// Footprints by surface decomposition (paper §4, issue 5): a mesh without trusted semantics is cut
+// into floor, ceiling and wall patches; a footprint is a closed lower boundary of the walls that is a
+// local minimum (the walls rise from every edge of it), projected to 2D.
+//
+// Input: any groundplan::Mesh (polygon faces with holes, triangle soup, duplicated vertices,
+// inconsistent facet orientation, non-manifold edges, T-junctions, several disconnected parts).
+// SurfaceKind is ignored except that lod0 outlines (FootPrint, RoofEdge) are not surfaces of the
+// solid and are skipped. Coordinates: x, y metric (working CRS), z up, metres.
+//
+// Output: polygons in the mesh's x, y with outer rings counter-clockwise and holes clockwise, closed
+// (no repeated closing vertex), no NaN. Rings of different parts of one mesh may overlap (the union
+// engine merges them). Never throws for bad geometry: an empty result and the stats say why.
+#include <groundplan/mesh.h>
+#include <groundplan/types.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace groundplan::footprint {
+
+struct DecomposeParams {
+  /// Proxy-plane tolerance (paper §4, VSA proxy): a facet whose normal is within this angle of the
+  /// vertical proxy normal is a floor (normal down) or ceiling (normal up) facet; the rest are walls.
+  /// Floors that follow terrain steeper than this count as walls and break the lower boundary: raise
+  /// it for hilly cities (ceilings and roofs do not care: their wall edges are upper boundaries).
+  double proxy_tolerance_deg = 20.0;
+  /// Vertices closer than this are one vertex (recovers connectivity of triangle soup and of
+  /// polygons written with their own copies of shared corners); also the distance within which a
+  /// vertex lying on another face's edge splits it (T-junctions). Metres.
+  double weld_tolerance_m = 1e-3;
+  /// Loops whose projected area is below this are dropped (slivers, vertical faces seen edge-on). m².
+  double min_loop_area_m2 = 1e-6;
+};
+
+enum class PatchKind : std::uint8_t { Floor, Ceiling, Wall };
+
+/// The decomposition itself (for tests and diagnostics; the footprint does not need it).
+struct SurfaceDecomposition {
+  std::vector<std::int32_t> face_patch;   // per mesh face: patch index, -1 for skipped/degenerate faces
+  std::vector<PatchKind> patch_kind;      // per patch
+  std::vector<double> patch_z;            // per patch: proxy-plane height (area-weighted mean z)
+  std::vector<double> patch_area_m2;      // per patch: facet area
+};
+
+struct DecomposeStats {
+  std::size_t faces_used = 0;             // faces with a usable outer ring
+  std::size_t vertices_welded = 0;        // distinct vertices after welding
+  std::size_t t_junction_splits = 0;      // edges split at a vertex lying on them
+  std::size_t nonmanifold_edges = 0;      // edges with more than two facets
+  std::size_t components = 0;             // parts connected through manifold edges
+  std::size_t unoriented_components = 0;  // parts whose outside could not be told (no volume)
+  std::size_t flipped_faces = 0;          // faces whose orientation was turned outward
+  std::size_t footprint_edges = 0;        // lower-boundary edges of the walls (local minima)
+  std::size_t loops = 0;                  // closed lower-boundary loops
+  std::size_t open_chains = 0;            // lower-boundary chains that did not close (not footprints)
+  std::size_t holes = 0;                  // loops that became holes
+  std::size_t dropped_loops = 0;          // loops below min area, or holes inside no outer ring
+};
+
+struct DecomposeResult {
+  std::vector<Polygon> polygons;
+  DecomposeStats stats;
+};
+
+/// Footprint polygons of `mesh` by surface decomposition. Fills `decomposition` when given.
+/// Thread-safe (per-thread scratch buffers).
+DecomposeResult decompose_footprint(const Mesh& mesh, const DecomposeParams& params = {},
+                                    SurfaceDecomposition* decomposition = nullptr);
+
+}  // namespace groundplan::footprint

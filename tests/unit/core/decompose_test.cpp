@@ -1,0 +1,386 @@
+// SPDX-License-Identifier: MIT
+// Footprints by surface decomposition (paper §4, issue 5): synthetic buildings made in code, one hard
+// case each, with known footprints compared through GEOS (symmetric difference, validity).
+#include "footprint/decompose.h"
+
+#include <groundplan/gis/geos_reference.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <random>
+
+namespace groundplan::footprint {
+namespace {
+
+using Ring3 = std::vector<Point3>;
+using Ring2 = std::vector<Point2>;
+using ZFn = std::function<double(double, double)>;
+
+double ring_area(const Ring2& r) {
+  double a = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const Point2 &p = r[i], &q = r[(i + 1) % r.size()];
+    a += p.x * q.y - q.x * p.y;
+  }
+  return a / 2;
+}
+
+Ring2 rect(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
+
+/// A prism over `outer` (CCW) with `holes` (CW): walls from z_bottom(x, y) to z_top, a floor and a
+/// roof when asked. Faces outward, as a clean closed solid would be written.
+Mesh prism(const Ring2& outer, const std::vector<Ring2>& holes, const ZFn& zb, double z_top, bool floor, bool roof) {
+  Mesh m;
+  auto walls = [&](const Ring2& r) {
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const Point2 &p = r[i], &q = r[(i + 1) % r.size()];
+      m.add_face({{{p.x, p.y, zb(p.x, p.y)}, {q.x, q.y, zb(q.x, q.y)}, {q.x, q.y, z_top}, {p.x, p.y, z_top}}},
+                 SurfaceKind::Wall, 2);
+    }
+  };
+  walls(outer);
+  for (const Ring2& h : holes) walls(h);
+  auto lift = [](const Ring2& r, const std::function<double(double, double)>& z, bool reverse) {
+    Ring3 out;
+    for (const Point2& p : r) out.push_back({p.x, p.y, z(p.x, p.y)});
+    if (reverse) std::reverse(out.begin(), out.end());
+    return out;
+  };
+  if (roof) {
+    std::vector<Ring3> rings{lift(outer, [&](double, double) { return z_top; }, false)};
+    for (const Ring2& h : holes) rings.push_back(lift(h, [&](double, double) { return z_top; }, false));
+    m.add_face(rings, SurfaceKind::Roof, 2);
+  }
+  if (floor) {
+    std::vector<Ring3> rings{lift(outer, zb, true)};
+    for (const Ring2& h : holes) rings.push_back(lift(h, zb, true));
+    m.add_face(rings, SurfaceKind::Ground, 2);
+  }
+  return m;
+}
+
+ZFn flat(double z) {
+  return [z](double, double) { return z; };
+}
+
+void append(Mesh& into, const Mesh& from) {
+  for (const MeshFace& f : from.faces) {
+    std::vector<Ring3> rings;
+    for (std::uint32_t r = f.first_ring; r < f.first_ring + f.ring_count; ++r) {
+      Ring3 ring;
+      for (std::uint32_t k = from.ring_offsets[r]; k < from.ring_offsets[r + 1]; ++k) ring.push_back(from.vertices[from.indices[k]]);
+      rings.push_back(ring);
+    }
+    into.add_face(rings, f.kind, f.lod);
+  }
+}
+
+/// Every face's rings reversed where `flip(face)` says so.
+Mesh reoriented(const Mesh& m, const std::function<bool(std::size_t)>& flip) {
+  Mesh out;
+  for (std::size_t i = 0; i < m.faces.size(); ++i) {
+    const MeshFace& f = m.faces[i];
+    std::vector<Ring3> rings;
+    for (std::uint32_t r = f.first_ring; r < f.first_ring + f.ring_count; ++r) {
+      Ring3 ring;
+      for (std::uint32_t k = m.ring_offsets[r]; k < m.ring_offsets[r + 1]; ++k) ring.push_back(m.vertices[m.indices[k]]);
+      if (flip(i)) std::reverse(ring.begin(), ring.end());
+      rings.push_back(ring);
+    }
+    out.add_face(rings, f.kind, f.lod);
+  }
+  return out;
+}
+
+/// Triangle soup: convex faces without holes fanned into triangles, each triangle with its own
+/// vertex copies jittered by up to `jitter`, triangles shuffled and randomly flipped (fixed seed).
+Mesh soup(const Mesh& m, double jitter, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> j(-jitter, jitter);
+  std::vector<std::array<Point3, 3>> tris;
+  for (const MeshFace& f : m.faces) {
+    const std::uint32_t a = m.ring_offsets[f.first_ring], b = m.ring_offsets[f.first_ring + 1];
+    for (std::uint32_t k = a + 1; k + 1 < b; ++k)
+      tris.push_back({m.vertices[m.indices[a]], m.vertices[m.indices[k]], m.vertices[m.indices[k + 1]]});
+  }
+  std::shuffle(tris.begin(), tris.end(), rng);
+  Mesh out;
+  for (auto& t : tris) {
+    if (rng() % 2) std::swap(t[1], t[2]);
+    Ring3 ring;
+    for (Point3 p : t) ring.push_back({p.x + j(rng), p.y + j(rng), p.z + j(rng)});
+    out.add_face({ring}, SurfaceKind::Unknown, 255);
+  }
+  return out;
+}
+
+struct Check {
+  double symdiff = 0, area = 0, expected_area = 0;
+  std::size_t invalid = 0, polygons = 0, holes = 0;
+};
+
+/// Our polygons against the expected WKT: symmetric difference (GEOS) and validity of each polygon.
+/// Several expected WKTs are unioned (they may overlap).
+Check compare(const DecomposeResult& res, const std::string& expected_wkt, const std::vector<std::string>& more = {}) {
+  Footprint ref;
+  ref.polygons = gis::polygons_from_wkt(expected_wkt);
+  for (const std::string& w : more)
+    for (Polygon& p : gis::polygons_from_wkt(w)) ref.polygons.push_back(std::move(p));
+  std::vector<GroundPlan> ours;
+  Check c;
+  for (const Polygon& p : res.polygons) {
+    ours.push_back(GroundPlan{p, {}, 0});
+    c.holes += p.holes.size();
+    for (const Point2& q : p.outer) EXPECT_TRUE(std::isfinite(q.x) && std::isfinite(q.y));
+    EXPECT_GT(ring_area(p.outer), 0) << "outer rings are counter-clockwise";
+    for (const Ring2& h : p.holes) EXPECT_LT(ring_area(h), 0) << "holes are clockwise";
+  }
+  const gis::GeosComparison g = gis::compare_with_geos({ref}, ours);
+  c.symdiff = g.symdiff_area;
+  c.area = g.area_ours;
+  c.expected_area = g.area_geos;
+  c.invalid = g.invalid_ours;
+  c.polygons = res.polygons.size();
+  return c;
+}
+
+constexpr double kEps = 1e-6;
+const char* kSquare = "POLYGON((0 0,10 0,10 10,0 10,0 0))";
+const char* kCourtyard = "POLYGON((0 0,20 0,20 20,0 20,0 0),(6 6,6 14,14 14,14 6,6 6))";
+
+Mesh courtyard(bool floor, bool roof, const ZFn& zb = flat(0), double z_top = 9) {
+  return prism(rect(0, 0, 20, 20), {{{6, 6}, {6, 14}, {14, 14}, {14, 6}}}, zb, z_top, floor, roof);
+}
+
+TEST(DecomposeFootprint, ClosedBox) {
+  const DecomposeResult r = decompose_footprint(prism(rect(0, 0, 10, 10), {}, flat(0), 6, true, true));
+  const Check c = compare(r, kSquare);
+  EXPECT_EQ(c.polygons, 1u);
+  EXPECT_LT(c.symdiff, kEps);
+  EXPECT_EQ(c.invalid, 0u);
+  EXPECT_EQ(r.stats.open_chains, 0u);
+}
+
+TEST(DecomposeFootprint, Decomposition) {
+  SurfaceDecomposition d;
+  decompose_footprint(prism(rect(0, 0, 10, 10), {}, flat(2), 6, true, true), {}, &d);
+  ASSERT_EQ(d.patch_kind.size(), 3u);
+  // Bottom-up: the floor (z 2) and the walls start lowest, the roof last.
+  EXPECT_EQ(std::count(d.patch_kind.begin(), d.patch_kind.end(), PatchKind::Floor), 1);
+  EXPECT_EQ(std::count(d.patch_kind.begin(), d.patch_kind.end(), PatchKind::Wall), 1);
+  EXPECT_EQ(d.patch_kind.back(), PatchKind::Ceiling);
+  EXPECT_NEAR(d.patch_z.back(), 6, 1e-12);
+  EXPECT_NEAR(d.patch_area_m2.back(), 100, 1e-9);
+  for (std::size_t p = 0; p < d.patch_kind.size(); ++p)
+    if (d.patch_kind[p] == PatchKind::Floor) {
+      EXPECT_NEAR(d.patch_z[p], 2, 1e-12);
+    }
+}
+
+TEST(DecomposeFootprint, OpenBottom) {
+  const DecomposeResult r = decompose_footprint(prism(rect(0, 0, 10, 10), {}, flat(0), 6, false, true));
+  const Check c = compare(r, kSquare);
+  EXPECT_EQ(c.polygons, 1u);
+  EXPECT_LT(c.symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, OpenBottomAndTop) {
+  // Four walls only: still a volume about the low point, still one way out.
+  const DecomposeResult r = decompose_footprint(prism(rect(0, 0, 10, 10), {}, flat(0), 6, false, false));
+  EXPECT_LT(compare(r, kSquare).symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, FloorWithHole) {
+  // The floor has an opening (a stair well to a basement, a missing polygon): the walls still say
+  // where the building stands, so the footprint is the whole square.
+  Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, false, true);
+  m.add_face({{{0, 0, 0}, {0, 10, 0}, {10, 10, 0}, {10, 0, 0}}, {{3, 3, 0}, {7, 3, 0}, {7, 7, 0}, {3, 7, 0}}},
+             SurfaceKind::Unknown, 2);
+  const Check c = compare(decompose_footprint(m), kSquare);
+  EXPECT_EQ(c.holes, 0u);
+  EXPECT_LT(c.symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, Courtyard) {
+  for (bool floor : {false, true}) {
+    const DecomposeResult r = decompose_footprint(courtyard(floor, true));
+    const Check c = compare(r, kCourtyard);
+    EXPECT_EQ(c.polygons, 1u);
+    EXPECT_EQ(c.holes, 1u);
+    EXPECT_LT(c.symdiff, kEps) << "floor " << floor;
+    EXPECT_EQ(c.invalid, 0u);
+  }
+}
+
+TEST(DecomposeFootprint, InconsistentOrientation) {
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    std::mt19937 rng(seed);
+    const Mesh m = reoriented(courtyard(false, true), [&](std::size_t) { return rng() % 2 == 1; });
+    const DecomposeResult r = decompose_footprint(m);
+    const Check c = compare(r, kCourtyard);
+    EXPECT_EQ(c.holes, 1u) << "seed " << seed;
+    EXPECT_LT(c.symdiff, kEps) << "seed " << seed;
+  }
+  // All faces inward (a shell written inside out).
+  const DecomposeResult r = decompose_footprint(reoriented(courtyard(true, true), [](std::size_t) { return true; }));
+  EXPECT_LT(compare(r, kCourtyard).symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, DuplicatedVerticesWithinTolerance) {
+  // Every face has its own corner copies (as readers deliver them), moved by up to 0.3 mm.
+  Mesh m = courtyard(false, true);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> j(-3e-4, 3e-4);
+  for (Point3& p : m.vertices) p = {p.x + j(rng), p.y + j(rng), p.z + j(rng)};
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_LT(compare(r, kCourtyard).symdiff, 0.05);  // area moves by jitter x perimeter at most
+  EXPECT_EQ(r.stats.open_chains, 0u);
+  EXPECT_EQ(r.stats.vertices_welded, 16u);  // 8 corners at two heights
+}
+
+TEST(DecomposeFootprint, TriangleSoup) {
+  // The courtyard roof and floor as convex quads (corner frame), then all of it triangle soup.
+  Mesh quads = prism(rect(0, 0, 20, 20), {{{6, 6}, {6, 14}, {14, 14}, {14, 6}}}, flat(0), 9, false, false);
+  const Ring2 o = rect(0, 0, 20, 20), h = rect(6, 6, 14, 14);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Point2 &a = o[i], &b = o[(i + 1) % 4], &c = h[(i + 1) % 4], &d = h[i];
+    quads.add_face({{{a.x, a.y, 9}, {b.x, b.y, 9}, {c.x, c.y, 9}, {d.x, d.y, 9}}}, SurfaceKind::Unknown, 255);
+    quads.add_face({{{d.x, d.y, 0}, {c.x, c.y, 0}, {b.x, b.y, 0}, {a.x, a.y, 0}}}, SurfaceKind::Unknown, 255);
+  }
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const DecomposeResult r = decompose_footprint(soup(quads, 2e-4, seed));
+    const Check c = compare(r, kCourtyard);
+    EXPECT_EQ(c.polygons, 1u) << "seed " << seed;
+    EXPECT_EQ(c.holes, 1u) << "seed " << seed;
+    EXPECT_LT(c.symdiff, 0.05) << "seed " << seed;
+    EXPECT_EQ(c.invalid, 0u) << "seed " << seed;
+  }
+  // Without welding (tolerance below the jitter) nothing connects: no footprint, and no garbage.
+  DecomposeParams p;
+  p.weld_tolerance_m = 1e-9;
+  EXPECT_TRUE(decompose_footprint(soup(quads, 2e-4, 1), p).polygons.empty());
+}
+
+TEST(DecomposeFootprint, SlopingTerrain) {
+  // Walls end on a sloping ground (lowest wall edge not at one height), with and without a floor
+  // following the slope (30 % = 16.7 degrees, inside the default proxy tolerance).
+  const ZFn slope = [](double x, double y) { return 100 + 0.3 * x + 0.05 * y; };
+  for (bool floor : {false, true}) {
+    const DecomposeResult r = decompose_footprint(courtyard(floor, true, slope));
+    const Check c = compare(r, kCourtyard);
+    EXPECT_EQ(c.holes, 1u) << "floor " << floor;
+    EXPECT_LT(c.symdiff, kEps) << "floor " << floor;
+  }
+  // A steep 60 % slope: fine with an open bottom; with a floor that steep the proxy tolerance must
+  // be raised, or the floor counts as a wall.
+  const ZFn steep = [](double x, double) { return 0.6 * x; };
+  EXPECT_LT(compare(decompose_footprint(courtyard(false, true, steep, 30)), kCourtyard).symdiff, kEps);
+  DecomposeParams hilly;
+  hilly.proxy_tolerance_deg = 35;
+  EXPECT_LT(compare(decompose_footprint(courtyard(true, true, steep, 30), hilly), kCourtyard).symdiff, kEps);
+}
+
+/// Ground floor [0,10]x[0,10] (z 0..3), upper storey [0,14]x[0,10] (z 3..6) cantilevered over x 10..14.
+/// `split`: walls written per storey, so the upper walls' bottom edges meet the soffit and the lower
+/// walls in T-junctions.
+Mesh overhang(bool floor, bool split) {
+  Mesh m;
+  if (split) {
+    m.add_face({{{0, 0, 0}, {10, 0, 0}, {10, 0, 3}, {0, 0, 3}}}, SurfaceKind::Wall, 2);
+    m.add_face({{{0, 0, 3}, {14, 0, 3}, {14, 0, 6}, {0, 0, 6}}}, SurfaceKind::Wall, 2);
+    m.add_face({{{10, 10, 0}, {0, 10, 0}, {0, 10, 3}, {10, 10, 3}}}, SurfaceKind::Wall, 2);
+    m.add_face({{{14, 10, 3}, {0, 10, 3}, {0, 10, 6}, {14, 10, 6}}}, SurfaceKind::Wall, 2);
+  } else {
+    m.add_face({{{0, 0, 0}, {10, 0, 0}, {10, 0, 3}, {14, 0, 3}, {14, 0, 6}, {0, 0, 6}}}, SurfaceKind::Wall, 2);
+    m.add_face({{{14, 10, 6}, {14, 10, 3}, {10, 10, 3}, {10, 10, 0}, {0, 10, 0}, {0, 10, 6}}}, SurfaceKind::Wall, 2);
+  }
+  m.add_face({{{0, 10, 0}, {0, 0, 0}, {0, 0, 6}, {0, 10, 6}}}, SurfaceKind::Wall, 2);        // x = 0
+  m.add_face({{{10, 0, 0}, {10, 10, 0}, {10, 10, 3}, {10, 0, 3}}}, SurfaceKind::Wall, 2);    // x = 10, below
+  m.add_face({{{14, 0, 3}, {14, 10, 3}, {14, 10, 6}, {14, 0, 6}}}, SurfaceKind::Wall, 2);    // x = 14, above
+  m.add_face({{{10, 0, 3}, {10, 10, 3}, {14, 10, 3}, {14, 0, 3}}}, SurfaceKind::Other, 2);   // soffit, down
+  m.add_face({{{0, 0, 6}, {14, 0, 6}, {14, 10, 6}, {0, 10, 6}}}, SurfaceKind::Roof, 2);
+  if (floor) m.add_face({{{0, 0, 0}, {0, 10, 0}, {10, 10, 0}, {10, 0, 0}}}, SurfaceKind::Ground, 2);
+  return m;
+}
+
+TEST(DecomposeFootprint, OverhangIsNotTheShadow) {
+  for (bool floor : {false, true})
+    for (bool split : {false, true}) {
+      SurfaceDecomposition d;
+      const DecomposeResult r = decompose_footprint(overhang(floor, split), {}, &d);
+      const Check c = compare(r, kSquare);
+      EXPECT_EQ(c.polygons, 1u) << floor << split;
+      EXPECT_LT(c.symdiff, kEps) << "floor " << floor << " split " << split << ": area " << c.area;
+      EXPECT_EQ(std::count(d.patch_kind.begin(), d.patch_kind.end(), PatchKind::Floor), floor ? 2 : 1);
+      if (split) {
+        EXPECT_GT(r.stats.t_junction_splits, 0u);
+      }
+    }
+}
+
+TEST(DecomposeFootprint, DisconnectedParts) {
+  Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, true, true);
+  append(m, prism(rect(30, 0, 40, 5), {}, flat(12), 20, false, true));
+  append(m, courtyard(false, true, flat(-3)));  // overlaps the first: the union engine merges them
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_EQ(r.polygons.size(), 3u);
+  EXPECT_EQ(r.stats.components, 3u);
+  const Check c = compare(r, kSquare, {kCourtyard, "POLYGON((30 0,40 0,40 5,30 5,30 0))"});
+  EXPECT_LT(c.symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, NonManifoldCornerContact) {
+  // Two boxes meeting along one vertical edge: four facets on that edge, two ways on at its foot.
+  Mesh m = prism(rect(0, 0, 1, 1), {}, flat(0), 3, true, true);
+  append(m, prism(rect(1, 1, 2, 2), {}, flat(0), 3, true, true));
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_GT(r.stats.nonmanifold_edges, 0u);
+  const Check c = compare(r, "MULTIPOLYGON(((0 0,1 0,1 1,0 1,0 0)),((1 1,2 1,2 2,1 2,1 1)))");
+  EXPECT_EQ(c.polygons, 2u);  // two simple rings touching at a point, not one figure-eight
+  EXPECT_EQ(c.invalid, 0u);
+  EXPECT_LT(c.symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, NonManifoldSharedWall) {
+  // Two closed boxes sharing a wall (each with its own copy): the shared wall's foot is no footprint
+  // edge (it rises on both sides), the footprint is the union.
+  Mesh m = prism(rect(0, 0, 1, 1), {}, flat(0), 3, true, true);
+  append(m, prism(rect(1, 0, 2, 1), {}, flat(0), 3, true, true));
+  const DecomposeResult r = decompose_footprint(m);
+  const Check c = compare(r, "POLYGON((0 0,2 0,2 1,0 1,0 0))");
+  EXPECT_LT(c.symdiff, kEps);
+  EXPECT_EQ(c.invalid, 0u);
+}
+
+TEST(DecomposeFootprint, DegenerateInput) {
+  Mesh empty;
+  EXPECT_TRUE(decompose_footprint(empty).polygons.empty());
+  Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, false, true);
+  m.add_face({{{1, 1, 1}, {1, 1, 1}, {1, 1, 1}}}, SurfaceKind::Unknown, 2);                       // a point
+  m.add_face({{{0, 0, 0}, {5, 5, 0}, {10, 10, 0}}}, SurfaceKind::Unknown, 2);                     // a line
+  m.add_face({{{0, 0, NAN}, {5, 0, 0}, {5, 5, 0}}}, SurfaceKind::Unknown, 2);                     // NaN
+  m.add_face({{{0, 0, 0}, {10, 0, 0}}}, SurfaceKind::Unknown, 2);                                 // 2 points
+  m.add_face({{{0, 0, 0}, {0, 10, 0}, {10, 10, 0}, {10, 0, 0}}}, SurfaceKind::FootPrint, 0);      // lod0: skipped
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_LT(compare(r, kSquare).symdiff, kEps);
+  // A single wall has no inside and no closed lower boundary.
+  Mesh wall;
+  wall.add_face({{{0, 0, 0}, {10, 0, 0}, {10, 0, 3}, {0, 0, 3}}}, SurfaceKind::Unknown, 2);
+  EXPECT_TRUE(decompose_footprint(wall).polygons.empty());
+}
+
+TEST(DecomposeFootprint, LargeCoordinates) {
+  // UTM-sized coordinates: welding and areas relative to a local origin keep their digits.
+  Mesh m = courtyard(false, true, flat(35));
+  for (Point3& p : m.vertices) p = {p.x + 389'000.25, p.y + 5'819'000.5, p.z};
+  const DecomposeResult r = decompose_footprint(m);
+  ASSERT_EQ(r.polygons.size(), 1u);
+  double a = ring_area(r.polygons[0].outer);
+  for (const Ring2& h : r.polygons[0].holes) a += ring_area(h);
+  EXPECT_NEAR(a, 400 - 64, 1e-6);
+}
+
+}  // namespace
+}  // namespace groundplan::footprint
