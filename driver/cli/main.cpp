@@ -192,19 +192,24 @@ int run(int argc, char** argv) {
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
   app.add_option("--preview", preview_path, "Write a PNG map of the plans (holes open, problem buildings in red)");
 
-  // GDAL's own general options (--config, --debug, --formats ...) are handled by GDAL first.
-  GDALAllRegister();
-  groundplan::driver::register_driver();
-  argc = GDALGeneralCmdLineProcessor(argc, &argv, 0);
-  if (argc < 1) return 0;  // --formats and friends were answered
-
-  std::vector<std::string> rest;
+  // Our flags first (so that --version and --help are ours, not GDAL's), then GDAL's own general
+  // options (--config, --debug, --formats ...) on what is left.
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
-  rest = app.remaining();
+  GDALAllRegister();
+  groundplan::driver::register_driver();
+  CPLStringList gdal_argv;
+  gdal_argv.AddString(argv[0]);
+  for (const std::string& a : app.remaining()) gdal_argv.AddString(a.c_str());
+  char** gdal_args = gdal_argv.StealList();
+  const int gdal_argc = GDALGeneralCmdLineProcessor(CSLCount(gdal_args), &gdal_args, 0);
+  std::vector<std::string> rest;
+  for (int i = 1; i < gdal_argc; ++i) rest.emplace_back(gdal_args[i]);
+  CSLDestroy(gdal_args);
+  if (gdal_argc < 1) return 0;  // --formats and friends were answered
   if (rest.empty()) {
     std::cout << app.help();
     return 1;

@@ -1,0 +1,85 @@
+# SPDX-License-Identifier: MIT
+"""The Debian package (CPack) built and unpacked in a scratch root: the CLI runs, GDAL finds the plugin in
+the packaged plugin folder, and a C++ program builds against the packaged headers and libgroundplan."""
+import glob
+import os
+import pathlib
+import shutil
+import subprocess
+
+import pytest
+
+from conftest import PLATEAU_SMALL
+
+BUILD_DIR = os.environ.get("GROUNDPLAN_BUILD_DIR")
+
+pytestmark = pytest.mark.skipif(not BUILD_DIR or shutil.which("cpack") is None or shutil.which("dpkg-deb") is None,
+                                reason="needs the CMake build folder, cpack and dpkg-deb")
+
+
+@pytest.fixture(scope="module")
+def root(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pkg")
+    p = subprocess.run(["cpack", "-G", "DEB", "-B", str(out), "--config", f"{BUILD_DIR}/CPackConfig.cmake"],
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout + p.stderr
+    debs = glob.glob(str(out / "*.deb"))
+    assert len(debs) == 1, debs
+    info = subprocess.run(["dpkg-deb", "-I", debs[0]], capture_output=True, text=True, check=True).stdout
+    assert "libgdal" in info and "libgeos" in info, "dependencies missing from the control file:\n" + info
+    root = out / "root"
+    subprocess.run(["dpkg-deb", "-x", debs[0], str(root)], check=True)
+    return root
+
+
+def _multiarch():
+    return subprocess.run(["gcc", "-print-multiarch"], capture_output=True, text=True).stdout.strip() or "x86_64-linux-gnu"
+
+
+def test_packaged_cli_runs(root, tmp_path):
+    exe = root / "usr" / "bin" / "groundplan"
+    assert exe.exists()
+    p = subprocess.run([str(exe), "--version"], capture_output=True, text=True)
+    assert p.returncode == 0 and "groundplan" in p.stdout
+    out = tmp_path / "p.gpkg"
+    p = subprocess.run([str(exe), "-f", "GPKG", str(out), str(PLATEAU_SMALL)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert out.exists()
+    assert (root / "usr" / "share" / "man" / "man1" / "groundplan.1").exists()
+
+
+def test_packaged_plugin_is_in_gdals_plugin_folder(root):
+    plugin_dir = root / "usr" / "lib" / _multiarch() / "gdalplugins"
+    assert (plugin_dir / "ogr_GroundPlan.so").exists()
+    env = dict(os.environ, GDAL_DRIVER_PATH=str(plugin_dir))
+    formats = subprocess.run(["ogrinfo", "--formats"], capture_output=True, text=True, env=env).stdout
+    assert "GroundPlan" in formats
+
+
+def test_cpp_program_builds_against_the_package(root, tmp_path):
+    include = root / "usr" / "include"
+    libdir = root / "usr" / "lib" / _multiarch()
+    pc = (libdir / "pkgconfig" / "groundplan.pc").read_text()
+    assert "-lgroundplan" in pc
+    assert (libdir / "cmake" / "groundplan" / "groundplanConfig.cmake").exists()
+    src = tmp_path / "two_squares.cpp"
+    src.write_text(r'''
+#include <groundplan/ground_plans.h>
+#include <cstdio>
+int main() {
+  using namespace groundplan;
+  std::vector<Footprint> fps(2);
+  fps[0].polygons = {Polygon{{{0, 0}, {2, 0}, {2, 2}, {0, 2}}, {}}};
+  fps[1].polygons = {Polygon{{{1, 1}, {3, 1}, {3, 3}, {1, 3}}, {}}};
+  std::vector<Problem> problems;
+  auto plans = build_ground_plans(fps, UnionParams{}, problems);
+  std::printf("%zu %.6f\n", plans.size(), plans.empty() ? 0.0 : plans[0].area_m2);
+  return 0;
+}
+''')
+    exe = tmp_path / "two_squares"
+    subprocess.run(["g++", "-std=c++20", f"-I{include}", str(src), f"-L{libdir}", "-lgroundplan", "-o", str(exe)],
+                   check=True, capture_output=True, text=True)
+    p = subprocess.run([str(exe)], capture_output=True, text=True, env=dict(os.environ, LD_LIBRARY_PATH=str(libdir)))
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["1", "7.000000"]
