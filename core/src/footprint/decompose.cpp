@@ -78,6 +78,17 @@ struct WeldEntry {
   std::uint32_t rep;
 };
 
+struct FaceEntry {
+  std::uint64_t hash;
+  std::uint32_t face, first, count, rings;
+  bool fwd;
+};
+
+struct Dup {
+  std::uint32_t slot, face;
+  bool fwd;
+};
+
 struct EdgeEntry {
   std::uint64_t key;
   std::uint32_t group;
@@ -105,6 +116,9 @@ struct Workspace {
   std::vector<FaceInfo> faces;
   std::vector<HalfEdge> halfedges, split_tmp;
   std::vector<EdgeEntry> edge_table;
+  std::vector<FaceEntry> face_table;
+  std::vector<std::uint32_t> canon;     // canonical welded outer rings, for duplicate faces
+  std::vector<Dup> dups;
   std::vector<std::uint32_t> he_group, group_count, group_start, group_members;
   std::vector<std::uint32_t> ring_tmp;
   std::vector<V3> comp_lo, comp_hi;
@@ -176,6 +190,7 @@ class Decomposer {
     stats_ = &res.stats;
     if (!find_origin()) return res;
     build_faces();
+    resolve_duplicates();
     if (stats_->faces_used == 0) return res;
     group_edges();
     if (split_t_junctions()) group_edges();
@@ -281,12 +296,82 @@ class Decomposer {
   }
 
   // ---- 2. faces and half-edges ------------------------------------------------------------------
+  /// Remembers the face's welded outer ring in canonical form (smallest vertex first, either
+  /// direction); faces seen before with the same ring and ring count are noted in `dups` for
+  /// resolve_duplicates().
+  void note_face(std::uint32_t f, std::uint32_t ring_count) {
+    const auto& r = ws_.ring_tmp;
+    const std::size_t k = r.size();
+    std::size_t start = 0;
+    for (std::size_t i = 1; i < k; ++i)
+      if (r[i] < r[start]) start = i;
+    const bool fwd = r[(start + 1) % k] < r[(start + k - 1) % k];
+    const std::size_t first = ws_.canon.size();
+    for (std::size_t i = 0; i < k; ++i) ws_.canon.push_back(r[fwd ? (start + i) % k : (start + k - i) % k]);
+    std::uint64_t h = mix64(k * 0x9E3779B97F4A7C15ULL + ring_count);
+    for (std::size_t i = first; i < first + k; ++i) h = mix64(h ^ ws_.canon[i]);
+    const std::size_t mask = ws_.face_table.size() - 1;
+    for (std::size_t s = h & mask;; s = (s + 1) & mask) {
+      FaceEntry& e = ws_.face_table[s];
+      if (e.face == kNone) {
+        e = FaceEntry{h, f, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(k), ring_count, fwd};
+        return;
+      }
+      if (e.hash == h && e.count == k && e.rings == ring_count &&
+          std::equal(ws_.canon.begin() + e.first, ws_.canon.begin() + e.first + k, ws_.canon.begin() + first)) {
+        ws_.canon.resize(first);
+        if (ws_.dups.empty() || ws_.dups.back().slot != s || ws_.dups.back().face != e.face)
+          ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), e.face, e.fwd});
+        ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), f, fwd});
+        return;
+      }
+    }
+  }
+
+  /// Faces written more than once. Copies running opposite ways are a face between two solids of one
+  /// mesh (each part closed on its own): both go, and the parts merge into one solid. Copies running
+  /// the same way are one face written twice (exporters do it): one stays. Either would otherwise
+  /// make the edges non-manifold and cancel the part's volume.
+  void resolve_duplicates() {
+    if (ws_.dups.empty()) return;
+    auto& d = ws_.dups;
+    std::sort(d.begin(), d.end(), [](const Dup& x, const Dup& y) { return x.slot < y.slot || (x.slot == y.slot && x.face < y.face); });
+    d.erase(std::unique(d.begin(), d.end(), [](const Dup& x, const Dup& y) { return x.slot == y.slot && x.face == y.face; }),
+            d.end());
+    for (std::size_t i = 0; i < d.size();) {
+      std::size_t j = i;
+      std::size_t nf = 0, nb = 0;
+      while (j < d.size() && d[j].slot == d[i].slot) (d[j].fwd ? nf : nb) += 1, ++j;
+      std::size_t cancel = std::min(nf, nb), keep = nf + nb > 2 * cancel ? 1 : 0;
+      std::size_t cf = cancel, cb = cancel;
+      for (std::size_t k = i; k < j; ++k) {
+        std::size_t& c = d[k].fwd ? cf : cb;
+        if (c > 0) {
+          --c;
+        } else if (keep > 0) {
+          --keep;
+          continue;
+        }
+        ws_.faces[d[k].face].cls = kSkipped;
+        ++stats_->duplicate_faces;
+        --stats_->faces_used;
+      }
+      i = j;
+    }
+    auto& he = ws_.halfedges;
+    he.erase(std::remove_if(he.begin(), he.end(), [&](const HalfEdge& h) { return ws_.faces[h.face].cls == kSkipped; }),
+             he.end());
+  }
+
   void build_faces() {
     tol_ = std::max(p_.weld_tolerance_m, 1e-9);
     ws_.weld.assign(m_.vertices.size(), kNone);
     ws_.wpos.clear();
     ws_.weld_table.assign(pow2_at_least(2 * m_.indices.size() + 16), WeldEntry{0, 0, 0, kNone});
     ws_.faces.assign(m_.faces.size(), FaceInfo{});
+    ws_.face_table.assign(pow2_at_least(2 * m_.faces.size() + 16), FaceEntry{0, kNone, 0, 0, 0, false});
+    ws_.canon.clear();
+    ws_.dups.clear();
     ws_.halfedges.clear();
     const std::size_t nrings = m_.ring_count();
     for (std::uint32_t f = 0; f < m_.faces.size(); ++f) {
@@ -299,6 +384,7 @@ class Decomposer {
       const V3 n = newell_tmp();
       const double len = std::sqrt(dot(n, n));
       if (!(len > 1e-12)) continue;  // zero area: no orientation, no class
+      note_face(f, mf.ring_count);
       fi.n = n;
       fi.len = len;
       fi.cls = kWall;  // refined in classify()
@@ -607,6 +693,12 @@ class Decomposer {
       for (std::uint32_t i = 0; i < c; ++i) {
         const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
         const FaceInfo& fi = ws_.faces[h.face];
+        if (fi.cls == kCeiling) {
+          // A ceiling boundary (paper §4: "except the ceiling boundaries"): walls rising from a roof
+          // (the inside of a parapet, a penthouse) stand on the building, not on the ground.
+          below = true;
+          break;
+        }
         if (fi.cls != kWall) continue;
         if (h.up < -kRise) {
           below = true;

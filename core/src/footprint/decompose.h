@@ -47,6 +47,7 @@ struct SurfaceDecomposition {
 
 struct DecomposeStats {
   std::size_t faces_used = 0;             // faces with a usable outer ring
+  std::size_t duplicate_faces = 0;        // copies of a face dropped (same welded outer ring)
   std::size_t vertices_welded = 0;        // distinct vertices after welding
   std::size_t t_junction_splits = 0;      // edges split at a vertex lying on them
   std::size_t nonmanifold_edges = 0;      // edges with more than two facets

@@ -354,6 +354,39 @@ TEST(DecomposeFootprint, NonManifoldSharedWall) {
   EXPECT_EQ(c.invalid, 0u);
 }
 
+TEST(DecomposeFootprint, FaceWrittenTwice) {
+  // A wall written twice the same way (v2_Building_and_garage_LOD2: the garage's west wall), and
+  // one written three times: the copies go, the box stays closed and oriented.
+  for (int copies : {1, 2}) {
+    const Mesh box = prism(rect(0, 0, 10, 10), {}, flat(0), 6, false, true);
+    Mesh m = box;
+    for (int c = 0; c < copies; ++c) append(m, box);
+    const DecomposeResult r = decompose_footprint(m);
+    EXPECT_EQ(r.stats.duplicate_faces, 5u * copies);
+    EXPECT_EQ(r.stats.nonmanifold_edges, 0u);
+    EXPECT_LT(compare(r, kSquare).symdiff, kEps);
+  }
+  Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, false, true);
+  m.add_face({{{0, 10, 0}, {0, 0, 0}, {0, 0, 6}, {0, 10, 6}}}, SurfaceKind::Wall, 2);
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_EQ(r.stats.duplicate_faces, 1u);
+  EXPECT_LT(compare(r, kSquare).symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, ParapetIsNotAFootprint) {
+  // A flat roof (z 6) inside a 1 m parapet: the parapet's inner walls rise from the roof, a closed
+  // loop of walls with higher neighbours, but a ceiling boundary (paper §4), not a footprint.
+  Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 7, false, false);
+  append(m, reoriented(prism(rect(1, 1, 9, 9), {}, flat(6), 7, false, false), [](std::size_t) { return true; }));
+  m.add_face({{{0, 0, 7}, {10, 0, 7}, {10, 10, 7}, {0, 10, 7}}, {{1, 1, 7}, {1, 9, 7}, {9, 9, 7}, {9, 1, 7}}},
+             SurfaceKind::Roof, 2);                                                            // parapet top
+  m.add_face({{{1, 1, 6}, {9, 1, 6}, {9, 9, 6}, {1, 9, 6}}}, SurfaceKind::Roof, 2);            // the roof
+  const DecomposeResult r = decompose_footprint(m);
+  const Check c = compare(r, kSquare);
+  EXPECT_EQ(c.holes, 0u);
+  EXPECT_LT(c.symdiff, kEps);
+}
+
 TEST(DecomposeFootprint, DegenerateInput) {
   Mesh empty;
   EXPECT_TRUE(decompose_footprint(empty).polygons.empty());
