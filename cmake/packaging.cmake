@@ -11,7 +11,7 @@ add_library(libgroundplan SHARED ${CMAKE_SOURCE_DIR}/packaging/libgroundplan.cpp
                                   $<TARGET_OBJECTS:groundplan_gis> $<TARGET_OBJECTS:groundplan_geosref>)
 target_link_libraries(libgroundplan PRIVATE groundplan_flags PkgConfig::MPFR TBB::tbb PROJ::proj EXPAT::EXPAT
                                             GEOS::geos_c GDAL::GDAL)
-if(CMAKE_CUDA_COMPILER)
+if(TARGET CUDA::cudart)
   target_link_libraries(libgroundplan PRIVATE CUDA::cudart)
 endif()
 target_include_directories(libgroundplan INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
