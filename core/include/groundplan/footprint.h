@@ -3,7 +3,7 @@
 // Mesh -> Footprint (DESIGN.md stage 3). The explicit path takes what the source says outright:
 // CityGML GroundSurface faces, else lod0FootPrint faces, else the bottom of an LoD1/LoD2 solid or
 // closed multi-surface (faces horizontal within a tolerance, at the mesh's lowest level, facing
-// down). Surface decomposition (paper §4) is issue 5.
+// down). Surface decomposition (paper §4, issue 5) finds it from the mesh alone.
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
@@ -12,9 +12,9 @@
 namespace groundplan {
 
 enum class FootprintSource {
-  Auto,           // explicit geometry; decomposition where that fails (once issue 5 lands)
+  Auto,           // explicit geometry where the source has it, else surface decomposition
   GroundSurface,  // explicit geometry only: GroundSurface, lod0FootPrint, the bottom of a solid
-  Decompose,      // surface decomposition (paper §4): not implemented yet
+  Decompose,      // surface decomposition (paper §4, issue 5) only; ignores what the source says
 };
 
 /// How the footprint was found.
@@ -30,13 +30,20 @@ struct FootprintParams {
   double level_tolerance_m = 0.5;
   /// Faces whose 2D area is below this (m²) are ignored (vertical faces mislabelled as ground ...).
   double min_face_area_m2 = 1e-6;
+  /// Decomposition: facets within this angle of the horizontal proxy plane are floors / ceilings,
+  /// the rest walls (paper §4). Raise it where floors follow steep terrain.
+  double proxy_tolerance_deg = 20.0;
+  /// Decomposition: vertices closer than this are welded (triangle soup, per-polygon copies) and a
+  /// vertex this close to another facet's edge splits it (T-junctions). Metres.
+  double weld_tolerance_m = 1e-3;
 };
 
 struct FootprintResult {
   bool ok = false;
   Footprint footprint;           // polygons (x, y of the mesh: the working CRS), source id and file, z range
   FootprintMethod method = FootprintMethod::None;
-  std::string code;              // when !ok: "NO_GROUND_GEOMETRY", "NOT_IMPLEMENTED", "EMPTY_MESH"
+  std::string code;              // when !ok: "NO_GROUND_GEOMETRY" (auto, ground-surface), "NO_FOOTPRINT_LOOP"
+                                 // (decompose), "EMPTY_MESH"
   std::string reason;            // when !ok: one sentence for the Problem
 };
 

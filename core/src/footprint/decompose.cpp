@@ -39,6 +39,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+constexpr std::uint32_t kBad = kNone - 1;  // a vertex with NaN or infinite coordinates
 /// A wall facet "rises" from an edge when the in-plane direction into it has at least this z
 /// component (unit vectors): vertical edges (0) and edges of walls leaning < 0.6° are neither.
 constexpr double kRise = 0.01;
@@ -141,6 +142,7 @@ struct Workspace {
   };
   std::vector<Loop> loops;
   std::vector<Point2> loop_pts;  // relative to the origin
+  std::vector<std::int32_t> poly_of_loop;
 };
 
 Workspace& workspace() {
@@ -222,28 +224,37 @@ class Decomposer {
   }
 
   // ---- 1. welding -------------------------------------------------------------------------------
+  static std::size_t cell_hash(std::int32_t x, std::int32_t y, std::int32_t z) {
+    std::uint64_t h = std::uint64_t(std::uint32_t(x)) * 0x9E3779B97F4A7C15ULL ^
+                      std::uint64_t(std::uint32_t(y)) * 0xC2B2AE3D27D4EB4FULL ^
+                      std::uint64_t(std::uint32_t(z)) * 0x165667B19E3779F9ULL;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+
+  /// Welded id of mesh vertex vi, kBad for a non-finite one. Grid cells are kCell x tol wide, so a
+  /// point needs the neighbouring cell on an axis only within tol of that side (mostly one probe).
   std::uint32_t weld_vertex(std::uint32_t vi) {
     std::uint32_t& w = ws_.weld[vi];
     if (w != kNone) return w;
     const Point3& q = m_.vertices[vi];
-    V3 p{q.x - o_.x, q.y - o_.y, q.z - o_.z};
-    const double inv = 1.0 / (2 * tol_);
+    if (!(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z))) return w = kBad;
+    const V3 p{q.x - o_.x, q.y - o_.y, q.z - o_.z};
+    constexpr double kCell = 16;
+    const double inv = 1.0 / (kCell * tol_);
     const double tx = p.x * inv, ty = p.y * inv, tz = p.z * inv;
     const double fx = std::floor(tx), fy = std::floor(ty), fz = std::floor(tz);
     // Cells beyond int32 range (a mesh kilometres across with a tiny tolerance) just clamp: the
-    // exact comparison below keeps welding correct, only the hashing gets slower.
-    auto clampi = [](double v) {
-      return static_cast<std::int32_t>(std::clamp(v, -2.0e9, 2.0e9));
-    };
+    // exact distance test keeps welding correct, only the hashing gets slower.
+    auto clampi = [](double v) { return static_cast<std::int32_t>(std::clamp(v, -2.0e9, 2.0e9)); };
     const std::int32_t kx = clampi(fx), ky = clampi(fy), kz = clampi(fz);
-    const std::int32_t sx = tx - fx < 0.5 ? -1 : 1, sy = ty - fy < 0.5 ? -1 : 1, sz = tz - fz < 0.5 ? -1 : 1;
+    auto side = [](double frac) { return frac < 1 / kCell ? -1 : frac > 1 - 1 / kCell ? 1 : 0; };
+    const std::int32_t sx = side(tx - fx), sy = side(ty - fy), sz = side(tz - fz);
     const std::size_t mask = ws_.weld_table.size() - 1;
     const double tol2 = tol_ * tol_;
     for (int c = 0; c < 8; ++c) {
+      if (((c & 1) && !sx) || ((c & 2) && !sy) || ((c & 4) && !sz)) continue;
       const std::int32_t cx = kx + ((c & 1) ? sx : 0), cy = ky + ((c & 2) ? sy : 0), cz = kz + ((c & 4) ? sz : 0);
-      std::size_t h = mix64((std::uint64_t(std::uint32_t(cx)) * 0x9E3779B97F4A7C15ULL) ^
-                            (std::uint64_t(std::uint32_t(cy)) << 21) ^ (std::uint64_t(std::uint32_t(cz)) << 42)) & mask;
-      for (;; h = (h + 1) & mask) {
+      for (std::size_t h = cell_hash(cx, cy, cz) & mask;; h = (h + 1) & mask) {
         const WeldEntry& e = ws_.weld_table[h];
         if (e.rep == kNone) break;
         if (e.kx == cx && e.ky == cy && e.kz == cz) {
@@ -254,16 +265,10 @@ class Decomposer {
     }
     w = static_cast<std::uint32_t>(ws_.wpos.size());
     ws_.wpos.push_back(p);
-    std::size_t h = mix64((std::uint64_t(std::uint32_t(kx)) * 0x9E3779B97F4A7C15ULL) ^
-                          (std::uint64_t(std::uint32_t(ky)) << 21) ^ (std::uint64_t(std::uint32_t(kz)) << 42)) & mask;
+    std::size_t h = cell_hash(kx, ky, kz) & mask;
     while (ws_.weld_table[h].rep != kNone) h = (h + 1) & mask;
     ws_.weld_table[h] = WeldEntry{kx, ky, kz, w};
     return w;
-  }
-
-  bool finite(std::uint32_t vi) const {
-    const Point3& q = m_.vertices[vi];
-    return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
   }
 
   /// Welded vertices of ring r into ring_tmp, consecutive repeats (and the closing repeat) removed.
@@ -274,8 +279,9 @@ class Decomposer {
     const std::uint32_t a = m_.ring_offsets[r], b = m_.ring_offsets[r + 1];
     for (std::uint32_t k = a; k < b; ++k) {
       const std::uint32_t vi = m_.indices[k];
-      if (vi >= m_.vertices.size() || !finite(vi)) return false;
+      if (vi >= m_.vertices.size()) return false;
       const std::uint32_t w = weld_vertex(vi);
+      if (w == kBad) return false;
       if (out.empty() || out.back() != w) out.push_back(w);
     }
     while (out.size() > 1 && out.back() == out.front()) out.pop_back();
@@ -871,8 +877,8 @@ class Decomposer {
         }
       }
     }
-    std::vector<std::size_t> outer_of_poly;  // polygon index -> loop index
-    std::vector<std::int32_t> poly_of_loop(loops.size(), -1);
+    auto& poly_of_loop = ws_.poly_of_loop;
+    poly_of_loop.assign(loops.size(), -1);
     auto ring = [&](const Workspace::Loop& L) {
       Ring r(L.count);
       const Point2* s = ws_.loop_pts.data() + L.first;

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Explicit footprints (DESIGN.md stage 3, issue 6): what the source says outright, in this order:
 // GroundSurface faces, lod0FootPrint faces, the bottom of an LoD1/LoD2 solid or closed
-// multi-surface. Decomposition (paper §4) is issue 5.
+// multi-surface. Decomposition (paper §4) is issue 5: footprint/decompose.cpp.
 #include <groundplan/footprint.h>
+
+#include "footprint/decompose.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,6 +84,25 @@ bool add_face_2d(const Mesh& m, const MeshFace& f, double min_area, std::vector<
   return true;
 }
 
+/// Footprint by surface decomposition (issue 5) into `res`; false with `why` when none was found.
+bool decompose_into(const Mesh& mesh, const FootprintParams& params, FootprintResult& res, std::string& why) {
+  footprint::DecomposeParams dp;
+  dp.proxy_tolerance_deg = params.proxy_tolerance_deg;
+  dp.weld_tolerance_m = params.weld_tolerance_m;
+  dp.min_loop_area_m2 = params.min_face_area_m2;
+  footprint::DecomposeResult d = footprint::decompose_footprint(mesh, dp);
+  if (!d.polygons.empty()) {
+    res.footprint.polygons = std::move(d.polygons);
+    res.ok = true;
+    res.method = FootprintMethod::Decomposition;
+    return true;
+  }
+  why = "surface decomposition found no closed lower wall boundary (" + std::to_string(d.stats.faces_used) +
+        " usable faces, " + std::to_string(d.stats.footprint_edges) + " lower-boundary edges, " +
+        std::to_string(d.stats.open_chains) + " chains that do not close)";
+  return false;
+}
+
 const char* kind_name(SurfaceKind k) {
   switch (k) {
     case SurfaceKind::Ground: return "GroundSurface";
@@ -108,12 +129,6 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   Footprint& fp = res.footprint;
   fp.source_id = mesh.source_id;
   fp.source_file = mesh.source_file;
-  if (params.source == FootprintSource::Decompose) {
-    res.code = "NOT_IMPLEMENTED";
-    res.reason = "footprints by surface decomposition (paper section 4, issue 5) are not implemented yet; "
-                 "use the explicit footprints (--footprints ground-surface or auto)";
-    return res;
-  }
   if (mesh.faces.empty() || mesh.vertices.empty()) {
     res.code = "EMPTY_MESH";
     res.reason = "the building has no faces";
@@ -124,6 +139,14 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   for (const Point3& p : mesh.vertices) {
     fp.min_z = std::min(fp.min_z, p.z);
     fp.max_z = std::max(fp.max_z, p.z);
+  }
+  if (params.source == FootprintSource::Decompose) {
+    std::string why;
+    if (!decompose_into(mesh, params, res, why)) {
+      res.code = "NO_FOOTPRINT_LOOP";
+      res.reason = why;
+    }
+    return res;
   }
 
   // 1. and 2.: faces the source calls ground (GroundSurface), else footprint (lod0FootPrint).
@@ -207,6 +230,16 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   } else {
     res.reason = "no GroundSurface, no lod0FootPrint, and no horizontal face lies at the building's lowest level "
                  "(within " + std::to_string(params.level_tolerance_m) + " m of z = " + std::to_string(zmin) + ")";
+  }
+  // Auto: no explicit ground geometry, so decomposition (issue 5).
+  if (params.source == FootprintSource::Auto) {
+    std::string why;
+    if (decompose_into(mesh, params, res, why)) {
+      res.code.clear();
+      res.reason.clear();
+      return res;
+    }
+    res.reason += "; " + why;
   }
   (void)kind_name;
   return res;

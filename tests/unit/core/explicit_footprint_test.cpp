@@ -134,14 +134,19 @@ TEST(ExplicitFootprint, NoGroundGeometryGivesAReason) {
       r[0].push_back(walls.vertices[walls.indices[k]]);
     only_walls.add_face(r, SurfaceKind::Wall, 2);
   }
-  FootprintResult r = make_footprint(only_walls);
+  FootprintParams explicit_only;  // Auto would fall back to decomposition (issue 5) and succeed
+  explicit_only.source = FootprintSource::GroundSurface;
+  FootprintResult r = make_footprint(only_walls, explicit_only);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.code, "NO_GROUND_GEOMETRY");
   EXPECT_NE(r.reason.find("none of its 4 faces is horizontal"), std::string::npos) << r.reason;
+  r = make_footprint(only_walls);
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.method, FootprintMethod::Decomposition);
 
   Mesh lid = only_walls;  // walls and a flat top, open at the bottom: the top is no footprint
   lid.add_face({{{0, 0, 10}, {10, 0, 10}, {10, 10, 10}, {0, 10, 10}}}, SurfaceKind::Unknown, 2);
-  r = make_footprint(lid);
+  r = make_footprint(lid, explicit_only);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.code, "NO_GROUND_GEOMETRY");
   EXPECT_NE(r.reason.find("lowest level"), std::string::npos) << r.reason;
@@ -157,16 +162,23 @@ TEST(ExplicitFootprint, NoGroundGeometryGivesAReason) {
   EXPECT_EQ(r.code, "EMPTY_MESH");
 }
 
-TEST(ExplicitFootprint, DecomposeIsNotImplementedYetAndSaysSo) {
+TEST(ExplicitFootprint, DecomposeIgnoresTheExplicitGeometry) {
+  // Issue 5 wired in: decomposition only (tests/unit/core/decompose_test.cpp has the hard cases).
   Mesh m;
   add_box(m, 0, 0, 0, 10, 10, 10);
   FootprintParams p;
   p.source = FootprintSource::Decompose;
   FootprintResult r = make_footprint(m, p);
+  EXPECT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.method, FootprintMethod::Decomposition);
+  ASSERT_EQ(r.footprint.polygons.size(), 1u);
+  EXPECT_EQ(r.footprint.polygons[0].outer.size(), 4u);
+  Mesh wall;  // one wall: no closed lower boundary, and the reason says so
+  wall.add_face({{{0, 0, 0}, {10, 0, 0}, {10, 0, 3}, {0, 0, 3}}}, SurfaceKind::Wall, 2);
+  r = make_footprint(wall, p);
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.code, "NOT_IMPLEMENTED");
-  EXPECT_TRUE(r.footprint.polygons.empty());
-  EXPECT_NE(r.reason.find("not implemented"), std::string::npos);
+  EXPECT_EQ(r.code, "NO_FOOTPRINT_LOOP");
+  EXPECT_NE(r.reason.find("no closed lower wall boundary"), std::string::npos) << r.reason;
   p.source = FootprintSource::GroundSurface;
   EXPECT_TRUE(make_footprint(m, p).ok);
 }
