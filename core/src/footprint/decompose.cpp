@@ -7,8 +7,9 @@
 //     readers give every polygon its own copy of its corners, and triangle soup has no connectivity at
 //     all (the paper's stated limitation).
 //  2. Boundary-oriented half-edges per face ring (holes turned against the outer ring), grouped by
-//     undirected welded edge. Edges seen by one facet only are split where another such edge's end lies
-//     on them (T-junctions, frequent in CityGML LoD2), then regrouped.
+//     undirected welded edge. Faces written twice are resolved (same way: one kept; opposite ways:
+//     a wall between two closed parts, both dropped). Edges seen by one facet only are split where
+//     another such edge's end lies on them (T-junctions, frequent in CityGML LoD2), then regrouped.
 //  3. Orientation: union-find with parity over manifold edges (two facets) makes every part's facets
 //     agree; the part's signed volume, taken about a point at the part's lowest z, says which way is
 //     out. The volume stays meaningful with an open bottom: the missing floor lies (nearly) in a plane
@@ -18,8 +19,10 @@
 //  5. Lower boundary: an edge is a footprint edge when a wall facet rises from it (the in-plane
 //     direction into the facet points up) and no wall facet continues below it: the paper's local
 //     minimum, decided per edge, so it does not depend on floors being present, whole or holed.
-//     Overhangs fail it where the wall below continues down, so the footprint is not the shadow.
-//     Edges of two wall facets that rise from it on opposite sides (parts sharing a wall) cancel.
+//     Not where a ceiling meets it (paper: "except the ceiling boundaries": parapets, penthouses),
+//     nor a floor patch from which a wall goes down elsewhere (a soffit: an upper storey wider than
+//     the one below on every side would otherwise give its shadow). Edges of two wall facets that
+//     rise from it on opposite sides (parts sharing a wall) cancel.
 //  6. Footprint edges, directed by the outward facet (building on the left), are chained into loops
 //     over welded vertices; at a vertex with several ways on, the leftmost turn is taken (ties by
 //     edge order), which keeps rings simple where parts touch at a corner. Chains that do not close
@@ -143,6 +146,8 @@ struct Workspace {
   std::vector<Loop> loops;
   std::vector<Point2> loop_pts;  // relative to the origin
   std::vector<std::int32_t> poly_of_loop;
+  std::vector<std::uint32_t> floor_uf;
+  std::vector<std::uint8_t> hanging;
 };
 
 Workspace& workspace() {
@@ -198,6 +203,7 @@ class Decomposer {
     if (split_t_junctions()) group_edges();
     orient();
     classify();
+    find_hanging_floors();
     if (dec) fill_decomposition(*dec);
     collect_footprint_edges();
     chain_loops();
@@ -626,6 +632,50 @@ class Decomposer {
 
   std::uint32_t comp_of(std::uint32_t f) const { return ws_.face_comp[f]; }
 
+  /// Floor patches from whose boundary a wall goes down are soffits (the underside of an upper
+  /// storey wider than the one below), not ground: walls rising from them are no footprint, or a
+  /// storey overhanging on every side would give its shadow. hanging[f] for floor facets.
+  void find_hanging_floors() {
+    const std::size_t nf = ws_.faces.size();
+    auto& par = ws_.floor_uf;
+    par.resize(nf);
+    ws_.hanging.assign(nf, 0);
+    bool any = false;
+    for (std::uint32_t f = 0; f < nf; ++f) {
+      par[f] = f;
+      any |= ws_.faces[f].cls == kFloor;
+    }
+    if (!any) return;
+    auto find = [&](std::uint32_t x) {
+      while (par[x] != x) x = par[x] = par[par[x]];
+      return x;
+    };
+    const std::size_t ng = ws_.group_count.size();
+    for (int pass = 0; pass < 2; ++pass)
+      for (std::size_t g = 0; g < ng; ++g) {
+        const std::uint32_t s = ws_.group_start[g], c = ws_.group_count[g];
+        std::uint32_t first_floor = kNone;
+        bool down = false;
+        for (std::uint32_t i = 0; i < c; ++i) {
+          const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
+          const std::uint8_t cls = ws_.faces[h.face].cls;
+          if (cls == kWall && h.up < -kRise) down = true;
+          if (cls != kFloor) continue;
+          if (pass == 0) {
+            if (first_floor == kNone) first_floor = h.face;
+            else par[find(h.face)] = find(first_floor);
+          }
+        }
+        if (pass == 1 && down)
+          for (std::uint32_t i = 0; i < c; ++i) {
+            const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
+            if (ws_.faces[h.face].cls == kFloor) ws_.hanging[find(h.face)] = 1;
+          }
+      }
+    for (std::uint32_t f = 0; f < nf; ++f)
+      if (ws_.faces[f].cls == kFloor) ws_.hanging[f] = ws_.hanging[find(f)];
+  }
+
   void fill_decomposition(SurfaceDecomposition& dec) {
     // Patches: facets of one class connected through shared edges. With the proxy normal fixed to
     // the vertical, the VSA growth from the lowest seeds reaches exactly these sets.
@@ -699,9 +749,10 @@ class Decomposer {
       for (std::uint32_t i = 0; i < c; ++i) {
         const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
         const FaceInfo& fi = ws_.faces[h.face];
-        if (fi.cls == kCeiling) {
+        if (fi.cls == kCeiling || (fi.cls == kFloor && ws_.hanging[h.face])) {
           // A ceiling boundary (paper §4: "except the ceiling boundaries"): walls rising from a roof
-          // (the inside of a parapet, a penthouse) stand on the building, not on the ground.
+          // (the inside of a parapet, a penthouse) stand on the building, not on the ground; so do
+          // walls rising from a soffit.
           below = true;
           break;
         }

@@ -320,6 +320,21 @@ TEST(DecomposeFootprint, OverhangIsNotTheShadow) {
     }
 }
 
+TEST(DecomposeFootprint, UpperStoreyWiderOnEverySide) {
+  // Ground storey [4,16]^2 (z 0..3), upper storey [0,20]^2 (z 3..8) overhanging on all sides: the
+  // upper walls' foot closes into a loop around the soffit, but the soffit hangs (walls go down from
+  // its inner edge), so the footprint is the ground storey, not the shadow.
+  for (bool floor : {false, true}) {
+    Mesh m = prism(rect(4, 4, 16, 16), {}, flat(0), 3, floor, false);
+    append(m, prism(rect(0, 0, 20, 20), {}, flat(3), 8, false, true));
+    m.add_face({{{0, 0, 3}, {0, 20, 3}, {20, 20, 3}, {20, 0, 3}}, {{4, 4, 3}, {16, 4, 3}, {16, 16, 3}, {4, 16, 3}}},
+               SurfaceKind::Other, 2);  // soffit, facing down
+    const DecomposeResult r = decompose_footprint(m);
+    const Check c = compare(r, "POLYGON((4 4,16 4,16 16,4 16,4 4))");
+    EXPECT_LT(c.symdiff, kEps) << "floor " << floor << ": area " << c.area;
+  }
+}
+
 TEST(DecomposeFootprint, DisconnectedParts) {
   Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, true, true);
   append(m, prism(rect(30, 0, 40, 5), {}, flat(12), 20, false, true));
@@ -352,6 +367,24 @@ TEST(DecomposeFootprint, NonManifoldSharedWall) {
   const Check c = compare(r, "POLYGON((0 0,2 0,2 1,0 1,0 0))");
   EXPECT_LT(c.symdiff, kEps);
   EXPECT_EQ(c.invalid, 0u);
+  // The second box's copy of the shared wall as two triangles: not a duplicate face, so the two
+  // walls rising from the shared foot on opposite sides must cancel there.
+  Mesh t = prism(rect(0, 0, 1, 1), {}, flat(0), 3, true, true);
+  const Mesh b = prism(rect(1, 0, 2, 1), {}, flat(0), 3, true, true);
+  for (std::size_t i = 0; i < b.faces.size(); ++i) {
+    Ring3 ring;
+    for (std::uint32_t k = b.ring_offsets[b.faces[i].first_ring]; k < b.ring_offsets[b.faces[i].first_ring + 1]; ++k)
+      ring.push_back(b.vertices[b.indices[k]]);
+    if (i == 3) {  // the x = 1 wall of the prism over rect(1, 0, 2, 1)
+      t.add_face({{ring[0], ring[1], ring[2]}}, SurfaceKind::Wall, 2);
+      t.add_face({{ring[0], ring[2], ring[3]}}, SurfaceKind::Wall, 2);
+    } else {
+      t.add_face({ring}, b.faces[i].kind, 2);
+    }
+  }
+  const DecomposeResult rt = decompose_footprint(t);
+  EXPECT_EQ(rt.stats.duplicate_faces, 0u);
+  EXPECT_LT(compare(rt, "POLYGON((0 0,2 0,2 1,0 1,0 0))").symdiff, kEps);
 }
 
 TEST(DecomposeFootprint, FaceWrittenTwice) {
