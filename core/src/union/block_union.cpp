@@ -46,6 +46,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -556,15 +559,18 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     for (std::size_t k = g0; k < g1; ++k)
       if (rays[k].edge < rays[pick].edge) pick = k;
     const Ray out = rays[pick];
-    const bool straight = cross_sign(L.a, L.b, out.from, out.to) == 0 && same_way(L.a, L.b, out.from, out.to);
     Event next = x0;
-    if (x0.cross && !straight && cross_sign(L.a, L.b, out.from, out.to) != 0) next = Event{true, {}, L.e};
-    if (!straight) ring.pts.push_back(point_of(L, x0));
+    if (x0.cross && cross_sign(L.a, L.b, out.from, out.to) != 0) next = Event{true, {}, L.e};
+    // every event point is kept here: a straight run may pass a point the walk turns at later
+    // (the ring touches itself there); split_simple needs to see it, then drops straight vertices
+    ring.pts.push_back(point_of(L, x0));
     group.assign(rays.begin() + static_cast<std::ptrdiff_t>(g0), rays.begin() + static_cast<std::ptrdiff_t>(g1));
     L = Line(out.edge, out.from, out.to);
     cur = next;
     // closed when we leave the start point again in the start direction
-    if (cross_sign(L0.a, L0.b, L.a, L.b) == 0 && same_way(L0.a, L0.b, L.a, L.b) && cmp(L0, cur, start0) == 0) break;
+    if (cross_sign(L0.a, L0.b, L.a, L.b) == 0 && same_way(L0.a, L0.b, L.a, L.b) && orient(L0.a, L0.b, L.a) == 0 &&
+        cmp(L0, cur, start0) == 0)
+      break;
   }
   ++stats_.rings_traced;
   rings_.push_back(std::move(ring));
@@ -712,16 +718,26 @@ long double signed_area2(const std::vector<Point2>& r) {
   return s;
 }
 
-/// Orientation of a simple ring, exactly from its lowest-leftmost vertex; 0 if degenerate there.
+/// Orientation of a ring: the sign of its area (long double, relative to its first vertex, so
+/// that 1e7 coordinates lose nothing) where that sign is certain, else exactly from its
+/// lowest-leftmost vertex (which is convex in a simple ring). The area decides first because a
+/// ring whose sub-ulp sliver was twisted by rounding can be wrong at that one vertex.
 int ring_orientation(const std::vector<Point2>& r) {
   const std::size_t n = r.size();
+  long double s = 0, mag = 0;
+  const Point2& o = r[0];
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const long double ax = static_cast<long double>(r[i].x) - o.x, ay = static_cast<long double>(r[i].y) - o.y;
+    const long double bx = static_cast<long double>(r[i + 1].x) - o.x, by = static_cast<long double>(r[i + 1].y) - o.y;
+    const long double t1 = ax * by, t2 = bx * ay;
+    s += t1 - t2;
+    mag += std::fabs(t1) + std::fabs(t2);
+  }
+  if (std::fabs(s) > mag * 1e-16L * static_cast<long double>(n + 4)) return s > 0 ? 1 : -1;
   std::size_t k = 0;
   for (std::size_t i = 1; i < n; ++i)
     if (r[i].y < r[k].y || (r[i].y == r[k].y && r[i].x < r[k].x)) k = i;
-  const int o = orient(r[(k + n - 1) % n], r[k], r[(k + 1) % n]);
-  if (o != 0) return o;
-  const long double a = signed_area2(r);
-  return (a > 0) - (a < 0);
+  return orient(r[(k + n - 1) % n], r[k], r[(k + 1) % n]);
 }
 
 /// +1 strictly inside, -1 strictly outside, 0 on the boundary (exact, on the rounded ring).
@@ -739,6 +755,186 @@ int point_in_ring(const Point2& p, const std::vector<Point2>& r) {
     if (lo.y <= p.y && p.y < hi.y && orient(lo, hi, p) > 0) odd = !odd;
   }
   return odd ? 1 : -1;
+}
+
+/// Rounding scale around a few points: a few ulps of the largest coordinate.
+double rounding_scale(std::initializer_list<Point2> pts) {
+  double m = 0;
+  for (const Point2& p : pts) m = std::max({m, std::fabs(p.x), std::fabs(p.y)});
+  return 8.0 * std::max(std::nextafter(m, INFINITY) - m, 1e-300);
+}
+
+/// Validity of one plan on its rounded coordinates, exactly (robust predicates on the doubles):
+/// OGC says no two ring edges may cross or overlap, and a ring may not touch itself; rings of one
+/// plan may touch at points. Returns false and the ring/vertex of a conflict if invalid.
+struct Conflict {
+  std::size_t ring_a, edge_a, ring_b, edge_b;
+};
+
+bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) {
+  struct Seg {
+    double minx, maxx, miny, maxy;
+    std::size_t ring, edge;
+  };
+  std::vector<Seg> segs;
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    const auto& R = *rings[r];
+    for (std::size_t i = 0, n = R.size(); i < n; ++i) {
+      const Point2& a = R[i];
+      const Point2& b = R[(i + 1) % n];
+      segs.push_back({std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), r, i});
+    }
+  }
+  std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.minx < y.minx; });
+  auto pt = [&](std::size_t r, std::size_t i) -> const Point2& { return (*rings[r])[i % rings[r]->size()]; };
+  auto on_seg = [](const Point2& a, const Point2& b, const Point2& p) {  // p on closed segment, collinear known
+    return std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= p.y &&
+           p.y <= std::max(a.y, b.y);
+  };
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    for (std::size_t j = i + 1; j < segs.size() && segs[j].minx <= segs[i].maxx; ++j) {
+      const Seg& s = segs[i];
+      const Seg& t = segs[j];
+      if (t.miny > s.maxy || s.miny > t.maxy) continue;
+      const std::size_t n = rings[s.ring]->size();
+      const bool same = s.ring == t.ring;
+      const bool adjacent = same && ((s.edge + 1) % n == t.edge || (t.edge + 1) % n == s.edge);
+      const Point2 &p1 = pt(s.ring, s.edge), &p2 = pt(s.ring, s.edge + 1);
+      const Point2 &q1 = pt(t.ring, t.edge), &q2 = pt(t.ring, t.edge + 1);
+      const int o1 = orient(p1, p2, q1), o2 = orient(p1, p2, q2), o3 = orient(q1, q2, p1), o4 = orient(q1, q2, p2);
+      bool bad = false;
+      if (o1 * o2 < 0 && o3 * o4 < 0) {
+        bad = true;  // proper crossing
+      } else if (o1 == 0 && o2 == 0) {
+        // collinear: overlap of positive length is invalid (also for adjacent edges: a spike)
+        const bool x = std::fabs(p2.x - p1.x) >= std::fabs(p2.y - p1.y);
+        auto k = [&](const Point2& p) { return x ? p.x : p.y; };
+        const double lo = std::max(std::min(k(p1), k(p2)), std::min(k(q1), k(q2)));
+        const double hi = std::min(std::max(k(p1), k(p2)), std::max(k(q1), k(q2)));
+        bad = lo < hi;
+      } else if (same && !adjacent) {
+        // a ring touching itself: a vertex on another edge of the same ring
+        bad = (o1 == 0 && on_seg(p1, p2, q1)) || (o2 == 0 && on_seg(p1, p2, q2)) || (o3 == 0 && on_seg(q1, q2, p1)) ||
+              (o4 == 0 && on_seg(q1, q2, p2));
+      }
+      if (bad) {
+        c = {s.ring, s.edge, t.ring, t.edge};
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+/// Removes, near a conflict between rings, the vertex whose triangle with its neighbours is
+/// smallest, provided that triangle is a sliver at rounding scale (its height a few ulps): such
+/// conflicts come from slivers whose exact width is below the rounding error. Returns false if no
+/// vertex qualifies (the caller reports a Problem instead of distorting the plan).
+bool repair_once(std::vector<std::vector<Point2>*>& rings, const Conflict& c) {
+  std::size_t best_r = 0, best_i = 0;
+  long double best = std::numeric_limits<long double>::infinity();
+  auto consider = [&](std::size_t r, std::size_t i) {
+    auto& R = *rings[r];
+    const std::size_t n = R.size();
+    if (n <= 3) return;
+    for (std::size_t d = 0; d < 2; ++d) {
+      const std::size_t k = (i + d) % n;
+      const Point2& a = R[(k + n - 1) % n];
+      const Point2& b = R[k];
+      const Point2& cc = R[(k + 1) % n];
+      const long double area = std::fabs(static_cast<long double>(b.x - a.x) * (cc.y - a.y) -
+                                         static_cast<long double>(b.y - a.y) * (cc.x - a.x));
+      if (area < best) {
+        best = area;
+        best_r = r;
+        best_i = k;
+      }
+    }
+  };
+  consider(c.ring_a, c.edge_a);
+  consider(c.ring_b, c.edge_b);
+  if (!std::isfinite(static_cast<double>(best))) return false;
+  {
+    const auto& R = *rings[best_r];
+    const std::size_t n = R.size();
+    const Point2& a = R[(best_i + n - 1) % n];
+    const Point2& b = R[best_i];
+    const Point2& c2 = R[(best_i + 1) % n];
+    const long double base = std::hypot(static_cast<long double>(c2.x) - a.x, static_cast<long double>(c2.y) - a.y);
+    if (best > base * rounding_scale({a, b, c2})) return false;  // |cross| = base * height
+  }
+  auto& R = *rings[best_r];
+  R.erase(R.begin() + static_cast<std::ptrdiff_t>(best_i));
+  return true;
+}
+
+long double dist_to_segment(const Point2& p, const Point2& a, const Point2& b) {
+  const long double dx = static_cast<long double>(b.x) - a.x, dy = static_cast<long double>(b.y) - a.y;
+  const long double px = static_cast<long double>(p.x) - a.x, py = static_cast<long double>(p.y) - a.y;
+  const long double l2 = dx * dx + dy * dy;
+  long double t = l2 > 0 ? (px * dx + py * dy) / l2 : 0;
+  t = std::clamp(t, 0.0L, 1.0L);
+  const long double ex = px - t * dx, ey = py - t * dy;
+  return std::sqrt(ex * ex + ey * ey);
+}
+
+/// Snap rounding, locally, of one rounded closed walk. The exact walk is a valid boundary; only
+/// rounding its crossing points can make two of its edges cross or a vertex land on another edge.
+/// Each such conflict is resolved by inserting the vertex nearest to the other edge into that edge
+/// (moving the boundary by at most that distance, a few ulps), after which the walk touches itself
+/// there and split_simple cuts it into simple rings. Returns false if a conflict is not at rounding
+/// scale (a bug, reported as a Problem by the caller).
+bool node_walk(std::vector<Point2>& w) {
+  for (int round = 0; round < 256; ++round) {
+    const std::size_t n = w.size();
+    if (n < 4) return true;
+    struct Seg {
+      double minx, maxx, miny, maxy;
+      std::size_t i;
+    };
+    std::vector<Seg> segs(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point2& a = w[i];
+      const Point2& b = w[(i + 1) % n];
+      segs[i] = {std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), i};
+    }
+    std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.minx < y.minx; });
+    bool found = false;
+    std::size_t ins_edge = 0;
+    Point2 ins_pt;
+    for (std::size_t u = 0; u < n && !found; ++u) {
+      for (std::size_t v = u + 1; v < n && segs[v].minx <= segs[u].maxx && !found; ++v) {
+        const Seg& s = segs[u];
+        const Seg& t = segs[v];
+        if (t.miny > s.maxy || s.miny > t.maxy) continue;
+        if ((s.i + 1) % n == t.i || (t.i + 1) % n == s.i) continue;  // adjacent: spikes go in split_simple
+        const Point2 &p1 = w[s.i], &p2 = w[(s.i + 1) % n], &q1 = w[t.i], &q2 = w[(t.i + 1) % n];
+        const int o1 = orient(p1, p2, q1), o2 = orient(p1, p2, q2), o3 = orient(q1, q2, p1), o4 = orient(q1, q2, p2);
+        auto strictly_inside = [](const Point2& a, const Point2& b, const Point2& x) {
+          return !(x == a) && !(x == b) && std::min(a.x, b.x) <= x.x && x.x <= std::max(a.x, b.x) &&
+                 std::min(a.y, b.y) <= x.y && x.y <= std::max(a.y, b.y);
+        };
+        // a vertex exactly on another edge's interior (also covers collinear overlaps)
+        if (o1 == 0 && strictly_inside(p1, p2, q1)) { found = true; ins_edge = s.i; ins_pt = q1; break; }
+        if (o2 == 0 && strictly_inside(p1, p2, q2)) { found = true; ins_edge = s.i; ins_pt = q2; break; }
+        if (o3 == 0 && strictly_inside(q1, q2, p1)) { found = true; ins_edge = t.i; ins_pt = p1; break; }
+        if (o4 == 0 && strictly_inside(q1, q2, p2)) { found = true; ins_edge = t.i; ins_pt = p2; break; }
+        if (o1 * o2 < 0 && o3 * o4 < 0) {
+          // proper crossing: node the endpoint nearest to the other segment into it
+          const long double d[4] = {dist_to_segment(q1, p1, p2), dist_to_segment(q2, p1, p2),
+                                    dist_to_segment(p1, q1, q2), dist_to_segment(p2, q1, q2)};
+          const int k = static_cast<int>(std::min_element(d, d + 4) - d);
+          if (d[k] > rounding_scale({p1, p2, q1, q2})) return false;
+          found = true;
+          ins_edge = k < 2 ? s.i : t.i;
+          ins_pt = k == 0 ? q1 : k == 1 ? q2 : k == 2 ? p1 : p2;
+        }
+      }
+    }
+    if (!found) return true;
+    w.insert(w.begin() + static_cast<std::ptrdiff_t>(ins_edge + 1), ins_pt);
+  }
+  return false;
 }
 
 /// Splits a closed walk at repeated (rounded) vertices into simple rings; drops collapsed parts.
@@ -773,6 +969,35 @@ void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point
         }
       }
     }
+    // drop vertices where the ring goes straight on (exactly collinear, same direction)
+    if (r.size() >= 3) {
+      std::vector<Point2> k;
+      k.reserve(r.size());
+      const std::size_t n = r.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Point2& a = r[(i + n - 1) % n];
+        const Point2& b = r[i];
+        const Point2& c = r[(i + 1) % n];
+        if (orient(a, b, c) == 0 && same_way(a, b, b, c)) continue;
+        k.push_back(b);
+      }
+      r.swap(k);
+    }
+    // a ring whose area is at rounding scale is a collapsed sliver (a gap or overlap between
+    // walls that coincide up to rounding): it has no area to give
+    if (r.size() >= 3) {
+      long double a2 = 0, per = 0;
+      double scale = 0;
+      for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+        const Point2& a = r[i];
+        const Point2& b = r[(i + 1) % n];
+        a2 += (static_cast<long double>(a.x) - r[0].x) * (static_cast<long double>(b.y) - r[0].y) -
+              (static_cast<long double>(b.x) - r[0].x) * (static_cast<long double>(a.y) - r[0].y);
+        per += std::hypot(static_cast<long double>(b.x) - a.x, static_cast<long double>(b.y) - a.y);
+        scale = std::max(scale, rounding_scale({a}));
+      }
+      if (std::fabs(a2) / 2 <= per * scale) r.clear();
+    }
     if (r.size() >= 3) out.push_back(std::move(r));
   };
   for (const Point2& p : pts) {
@@ -803,7 +1028,14 @@ void BlockEngine::assemble(BlockResult& out) {
   std::vector<R> outers, holes;
   for (std::size_t i = 0; i < rings_.size(); ++i) {
     std::vector<std::vector<Point2>> parts;
-    split_simple(rings_[i].pts, parts);
+    std::vector<Point2> w;
+    for (const Point2& p : rings_[i].pts)
+      if (w.empty() || !(w.back() == p)) w.push_back(p);
+    while (w.size() > 1 && w.front() == w.back()) w.pop_back();
+    if (!node_walk(w))
+      out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                     "a boundary crosses itself after rounding by more than rounding error"});
+    split_simple(w, parts);
     for (auto& p : parts) {
       const int o = ring_orientation(p);
       if (o == 0) continue;
@@ -870,6 +1102,28 @@ void BlockEngine::assemble(BlockResult& out) {
     for (std::size_t h : holes_of[k]) {
       a2 += holes[h].area2;
       g.polygon.holes.push_back(std::move(holes[h].pts));
+    }
+    // Rounded output must stay valid (issue 3): check exactly, repair rounding slivers locally.
+    {
+      std::vector<std::vector<Point2>*> rr{&g.polygon.outer};
+      for (Ring& h : g.polygon.holes) rr.push_back(&h);
+      Conflict c{};
+      int repairs = 0;
+      while (find_conflict(rr, c)) {
+        if (repairs >= 32 || !repair_once(rr, c)) {
+          const Point2& p = (*rr[c.ring_a])[c.edge_a % rr[c.ring_a]->size()];
+          out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                         "rounding intersection points to doubles left a self-intersection near (" +
+                                             std::to_string(p.x) + ", " + std::to_string(p.y) + ")"});
+          break;
+        }
+        ++repairs;
+        ++stats_.rounding_repairs;
+      }
+      if (repairs > 0) {
+        a2 = signed_area2(g.polygon.outer);
+        for (const Ring& h : g.polygon.holes) a2 += signed_area2(h);
+      }
     }
     g.area_m2 = static_cast<double>(a2 / 2);
     for (std::uint32_t p : polys_of[k]) g.members.push_back(polys_[p].footprint);

@@ -14,6 +14,7 @@ struct BlockStats {
   std::uint64_t rings_traced = 0;    // closed boundary walks
   std::uint64_t seeds_from_check = 0;// walks started by the completeness check (holes, separate rings)
   std::uint64_t edges_checked = 0;   // input edges the completeness check had to examine exactly
+  std::uint64_t rounding_repairs = 0;// vertices removed because rounding made a sliver invalid
 };
 
 struct BlockResult {
