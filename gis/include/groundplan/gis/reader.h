@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// One entry point for every input format (DESIGN.md stage 1-2, issue 6). The format is chosen by
+// extension, and by content where the extension says nothing (.xml, no extension, /vsi paths):
+//   .gml .citygml .xml     CityGML        meshes as written (info.in_working_crs == false): the caller
+//                                         transforms them with a WorkingFrame from info.citygml.srs_name
+//   .kml .kmz              KML + COLLADA  meshes in the working CRS (placed with GeographicLib + PROJ)
+//   .gltf .glb             glTF           meshes in the working CRS (ECEF georeference, else origin)
+//   .dae                   COLLADA alone  meshes in the working CRS; needs ReadOptions::origin
+// The working CRS of self-georeferenced formats is ReadOptions::target_srs when given, else the
+// WGS 84 UTM zone of the first model's anchor; it is in info.working_crs once a mesh was placed.
+#include <groundplan/gis/citygml.h>
+#include <groundplan/gis/crs.h>
+#include <groundplan/gis/gltf.h>
+#include <groundplan/gis/kml.h>
+#include <groundplan/mesh.h>
+#include <groundplan/types.h>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace groundplan::gis {
+
+enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb };
+const char* to_string(InputFormat format);
+
+struct ReadOptions {
+  int lod = -1;                 // CityGML: -1 = the highest LoD each building has
+  std::string target_srs;       // working CRS for KML/glTF/COLLADA (-t_srs, or the first file's); empty = UTM
+  std::string origin;           // "lon,lat[,alt]" for glTF without georeference and bare .dae; empty = none
+  KmlOptions kml;               // byte limits (KMZ), COLLADA limits
+  GltfOptions gltf;
+};
+
+struct ReadInfo {
+  std::string file;
+  InputFormat format = InputFormat::Unknown;
+  bool in_working_crs = false;  // meshes arrive in working_crs (KML, glTF, COLLADA); false: as written (CityGML)
+  WorkingCrs working_crs;       // valid when in_working_crs and something was placed
+  std::vector<std::string> notes;  // georeference notes (UTM zone chosen ...)
+  SourceInfo citygml;           // CityGML only
+  KmlInfo kml;                  // KML/KMZ only
+  GltfInfo gltf;                // glTF only
+  std::size_t meshes = 0;       // meshes delivered
+};
+
+/// The format of `path`: by extension, else by its first bytes (zip -> Kmz, "glTF" -> Glb, XML root
+/// <kml>/<COLLADA>/CityGML namespace, '{' with "asset" -> Gltf). Unknown when nothing fits.
+InputFormat detect_format(const std::string& path);
+/// The same from a file name and its first bytes (for a driver's Identify). Does not throw.
+InputFormat detect_format(const std::string& name, std::string_view head);
+/// True for the extensions a folder of tiles is expanded to (.gml .citygml .xml .kml .kmz .gltf .glb;
+/// not .dae: a .dae beside a .kml is the KML's model, not a second input).
+bool is_input_name(const std::string& name);
+
+/// Reads one file of any supported format. `info.format` and `info.in_working_crs` are set before
+/// the first mesh is delivered. Per-building defects are Problems. Throws InputError naming the file
+/// when it cannot be read at all, when its format is unknown, or when a glTF / COLLADA file has no
+/// georeference and no origin was given ("pass --origin lon,lat,alt"); InvalidArgument for a bad
+/// origin or target CRS. Exceptions thrown by `on_mesh` propagate.
+void read_any(const std::string& path, const ReadOptions& options, const MeshCallback& on_mesh,
+              std::vector<Problem>& problems, ReadInfo& info);
+
+}  // namespace groundplan::gis

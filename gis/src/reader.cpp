@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: MIT
+// Format dispatch (issue 6): CityGML passes through as written; KML/KMZ, COLLADA and glTF carry
+// their own georeference and are placed here, so the pipeline sees meshes in the working CRS.
+#include <groundplan/error.h>
+#include <groundplan/gis/collada.h>
+#include <groundplan/gis/placement.h>
+#include <groundplan/gis/reader.h>
+
+#include <cpl_vsi.h>
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+
+namespace groundplan::gis {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string extension(const std::string& name) {
+  const auto slash = name.find_last_of("/\\");
+  const auto dot = name.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
+  return lower(name.substr(dot));
+}
+
+InputFormat sniff(std::string_view head) {
+  if (head.size() >= 4 && std::memcmp(head.data(), "PK\x03\x04", 4) == 0) return InputFormat::Kmz;
+  if (head.size() >= 4 && std::memcmp(head.data(), "glTF", 4) == 0) return InputFormat::Glb;
+  const auto first = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+  if (first == std::string_view::npos) return InputFormat::Unknown;
+  if (head[first] == '{') return head.find("\"asset\"") != std::string_view::npos ? InputFormat::Gltf : InputFormat::Unknown;
+  if (head[first] != '<') return InputFormat::Unknown;
+  if (looks_like_citygml(head)) return InputFormat::CityGml;
+  if (head.find("<COLLADA") != std::string_view::npos) return InputFormat::Collada;
+  if (head.find("<kml") != std::string_view::npos || head.find(":kml") != std::string_view::npos) return InputFormat::Kml;
+  if (head.find("http://www.opengis.net/citygml/") != std::string_view::npos) return InputFormat::CityGml;
+  return InputFormat::Unknown;
+}
+
+std::string read_head(const std::string& path) {
+  std::string head(4096, '\0');
+  VSILFILE* f = VSIFOpenL(path.c_str(), "rb");
+  if (!f) return {};
+  head.resize(VSIFReadL(head.data(), 1, head.size(), f));
+  VSIFCloseL(f);
+  return head;
+}
+
+}  // namespace
+
+const char* to_string(InputFormat f) {
+  switch (f) {
+    case InputFormat::Unknown: return "unknown";
+    case InputFormat::CityGml: return "CityGML";
+    case InputFormat::Kml: return "KML";
+    case InputFormat::Kmz: return "KMZ";
+    case InputFormat::Collada: return "COLLADA";
+    case InputFormat::Gltf: return "glTF";
+    case InputFormat::Glb: return "GLB";
+  }
+  return "?";
+}
+
+InputFormat detect_format(const std::string& name, std::string_view head) {
+  const std::string ext = extension(name);
+  if (ext == ".gml" || ext == ".citygml") return InputFormat::CityGml;
+  if (ext == ".kml") return InputFormat::Kml;
+  if (ext == ".kmz") return InputFormat::Kmz;  // not a zip: the KML reader says so
+  if (ext == ".dae") return InputFormat::Collada;
+  if (ext == ".gltf") return InputFormat::Gltf;
+  if (ext == ".glb") return InputFormat::Glb;
+  const InputFormat by_content = sniff(head);
+  if (ext == ".xml" && by_content == InputFormat::Unknown) return InputFormat::CityGml;  // NOT_CITYGML if not
+  return by_content;
+}
+
+InputFormat detect_format(const std::string& path) {
+  const std::string ext = extension(path);
+  if (!ext.empty() && ext != ".xml") {
+    const InputFormat f = detect_format(path, std::string_view());
+    if (f != InputFormat::Unknown) return f;
+  }
+  return detect_format(path, read_head(path));
+}
+
+bool is_input_name(const std::string& name) {
+  const std::string ext = extension(name);
+  return ext == ".gml" || ext == ".citygml" || ext == ".xml" || ext == ".kml" || ext == ".kmz" || ext == ".gltf" ||
+         ext == ".glb";
+}
+
+void read_any(const std::string& path, const ReadOptions& options, const MeshCallback& on_mesh,
+              std::vector<Problem>& problems, ReadInfo& info) {
+  info = ReadInfo{};
+  info.file = path;
+  info.format = detect_format(path);
+  if (info.format == InputFormat::Unknown) {
+    VSIStatBufL st;
+    if (VSIStatL(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+    throw InputError(path + ": format not recognised (CityGML .gml/.citygml/.xml, KML .kml/.kmz, glTF .gltf/.glb, "
+                            "COLLADA .dae are read)");
+  }
+  if (info.format == InputFormat::CityGml) {
+    CityGmlOptions opt;
+    opt.lod = options.lod;
+    read_citygml(path, opt, [&](Mesh&& m) {
+      ++info.meshes;
+      on_mesh(std::move(m));
+    }, problems, info.citygml);
+    return;
+  }
+
+  info.in_working_crs = true;
+  CrsOptions crs;
+  crs.target_srs = options.target_srs;
+  Georeferencer geo(crs, path);
+  std::optional<ModelPlacement> origin;
+  if (!options.origin.empty()) origin = parse_origin(options.origin);
+  auto deliver = [&](Mesh& mesh, bool ok, const std::string& reason) {
+    if (!ok) {
+      problems.push_back(Problem{mesh.source_id, path, "georeference", "TRANSFORM_FAILED", reason});
+      return;
+    }
+    ++info.meshes;
+    on_mesh(std::move(mesh));
+  };
+  auto finish = [&] {
+    if (geo.decided() && geo.working_crs().known) info.working_crs = geo.working_crs();
+    info.notes = geo.notes();
+  };
+  const std::string no_origin = ": has no georeference (no KML Location, no CESIUM_RTC, no ECEF transform): pass "
+                                "--origin lon,lat,alt (degrees, degrees, metres) to place its local frame";
+
+  switch (info.format) {
+    case InputFormat::Kml:
+    case InputFormat::Kmz:
+      try {
+        read_kml(path, options.kml, [&](Mesh&& mesh, const ModelPlacement& pl) {
+          std::string reason;
+          const bool ok = geo.place_local(mesh, pl, &reason);
+          deliver(mesh, ok, reason);
+        }, problems, info.kml);
+      } catch (...) {
+        finish();
+        throw;
+      }
+      break;
+    case InputFormat::Collada: {
+      if (!origin) throw InputError(path + no_origin);
+      ColladaOptions copt = options.kml.collada;
+      copt.max_bytes = options.kml.max_entry_bytes;
+      ColladaInfo cinfo;
+      Mesh mesh = read_collada(path, path, copt, problems, cinfo);
+      if (!mesh.faces.empty()) {
+        std::string reason;
+        const bool ok = geo.place_local(mesh, *origin, &reason);
+        deliver(mesh, ok, reason);
+      }
+      break;
+    }
+    case InputFormat::Gltf:
+    case InputFormat::Glb:
+      try {
+        read_gltf(path, options.gltf, [&](Mesh&& mesh, GltfFrame frame) {
+          std::string reason;
+          bool ok = false;
+          if (frame == GltfFrame::Ecef) {
+            ok = geo.place_ecef(mesh, &reason);
+          } else {
+            if (!origin) throw InputError(path + no_origin);
+            ok = geo.place_local(mesh, *origin, &reason);
+          }
+          deliver(mesh, ok, reason);
+        }, problems, info.gltf);
+      } catch (...) {
+        finish();
+        throw;
+      }
+      break;
+    default:
+      break;
+  }
+  finish();
+}
+
+}  // namespace groundplan::gis
