@@ -5,6 +5,7 @@
 #include <groundplan/gis/citygml.h>
 #include <groundplan/gis/crs.h>
 #include <groundplan/gis/pipeline.h>
+#include <groundplan/gis/reader.h>
 
 #include <algorithm>
 #include <chrono>
@@ -27,12 +28,8 @@ std::string lower(std::string s) {
   return s;
 }
 
-bool is_citygml_name(const fs::path& p) {
-  const std::string ext = lower(p.extension().string());
-  return ext == ".gml" || ext == ".citygml" || ext == ".xml";
-}
-
-/// Files named by the inputs: a file as is, a folder as its CityGML files sorted by name.
+/// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF;
+/// not .dae, which belong to a .kml beside them) sorted by name.
 std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
@@ -40,9 +37,10 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
     if (fs::is_directory(in, ec)) {
       std::vector<std::string> found;
       for (const auto& e : fs::directory_iterator(in, ec))
-        if (e.is_regular_file() && is_citygml_name(e.path())) found.push_back(e.path().string());
+        if (e.is_regular_file() && is_input_name(e.path().filename().string())) found.push_back(e.path().string());
       std::sort(found.begin(), found.end());
-      if (found.empty()) throw InputError(in + ": folder holds no CityGML file (*.gml, *.citygml, *.xml)");
+      if (found.empty())
+        throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb)");
       files.insert(files.end(), found.begin(), found.end());
     } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0) {
       files.push_back(in);
@@ -93,8 +91,9 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
   PipelineResult result;
   const std::vector<std::string> files = expand_inputs(options.inputs);
 
-  CityGmlOptions read_options;
+  ReadOptions read_options;
   read_options.lod = options.lod;
+  read_options.origin = options.origin;
   FootprintParams footprint_params;
   footprint_params.source = to_core(options.footprints);
 
@@ -111,17 +110,18 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     const Progress file_progress = progress.sub(0.6 * static_cast<double>(fi) / static_cast<double>(files.size()),
                                                 0.6 * static_cast<double>(fi + 1) / static_cast<double>(files.size()));
     file_progress.report(0, "reading");
-    SourceInfo info;
+    ReadInfo info;
     std::unique_ptr<WorkingFrame> frame;
+    read_options.target_srs = working_definition;  // KML/glTF are placed by the reader, in this CRS
     auto on_mesh = [&](Mesh&& mesh) {
       ++result.buildings_read;
-      if (!frame) {
+      if (!info.in_working_crs && !frame) {
         CrsOptions crs;
         crs.target_srs = working_definition;
-        frame = std::make_unique<WorkingFrame>(info.srs_name, crs, file);
+        frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
       }
       std::string reason;
-      if (!frame->transform(mesh, &reason)) {
+      if (frame && !frame->transform(mesh, &reason)) {
         result.problems.push_back({mesh.source_id, file, "georeference", "TRANSFORM_FAILED", reason});
         return;
       }
@@ -138,7 +138,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
       if ((result.buildings_read & 1023) == 0) file_progress.report(0.5, "reading");
     };
     try {
-      read_citygml(file, read_options, on_mesh, result.problems, info);
+      read_any(file, read_options, on_mesh, result.problems, info);
     } catch (const Cancelled&) {
       throw;
     } catch (const InputError& e) {
@@ -146,6 +146,14 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
       ++files_failed;
       if (first_failure.empty()) first_failure = e.what();
       result.problems.push_back({"", file, "read", "UNREADABLE_FILE", e.what()});
+    }
+    if (info.in_working_crs) {
+      for (const std::string& note : info.notes) result.problems.push_back({"", file, "georeference", "NOTE", note});
+      if (result.crs_wkt.empty() && info.working_crs.known) {
+        result.crs_wkt = info.working_crs.wkt;
+        result.crs_name = info.working_crs.epsg ? "EPSG:" + std::to_string(info.working_crs.epsg) : info.working_crs.name;
+        if (working_definition.empty()) working_definition = info.working_crs.definition;
+      }
     }
     if (frame) {
       for (const std::string& note : frame->notes()) result.problems.push_back({"", file, "georeference", "NOTE", note});

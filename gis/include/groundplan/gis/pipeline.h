@@ -14,10 +14,11 @@ namespace groundplan::gis {
 enum class FootprintMode { Auto, GroundSurface, Decompose };
 
 struct PipelineOptions {
-  std::vector<std::string> inputs;  // files or folders (a folder: every CityGML file in it, sorted by name)
+  std::vector<std::string> inputs;  // files or folders (a folder: its CityGML, KML/KMZ, glTF files, sorted by name)
   FootprintMode footprints = FootprintMode::Auto;
   int lod = -1;                     // -1 = the highest LoD each building has
   std::string t_srs;                // working CRS as the user names it (EPSG:n, WKT, PROJ string); empty = automatic
+  std::string origin;               // "lon,lat[,alt]": where a glTF without georeference or a bare .dae sits; empty = none
   UnionParams union_params;
 };
 
