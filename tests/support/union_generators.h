@@ -39,8 +39,10 @@ constexpr Family kAllFamilies[] = {Family::PartyWalls,   Family::CollinearOverla
 /// One random case of the family (a few to a few dozen footprints).
 std::vector<Footprint> generate_case(Family f, Rng& rng);
 
-/// A synthetic city of about n footprints (benchmark): blocks of row houses with exact party walls,
+/// A synthetic city of n footprints (benchmark): blocks of row houses with exact party walls,
 /// courtyards, overlapping wings, rotated blocks, detached houses; origin at (500000, 5400000).
-std::vector<Footprint> synthetic_city(std::size_t n, std::uint64_t seed);
+/// coverage = true leaves out everything that overlaps and every partial wall, so that the result
+/// is a valid polygonal coverage (for GEOSCoverageUnion).
+std::vector<Footprint> synthetic_city(std::size_t n, std::uint64_t seed, bool coverage = false);
 
 }  // namespace groundplan::testing

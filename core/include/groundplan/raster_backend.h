@@ -69,7 +69,7 @@ FootprintSet make_footprint_set(const std::vector<Footprint>& footprints);
 
 /// The grid over the set. resolution_m > 0 is used as given (coarsened only if the grid would
 /// exceed 2^31 pixels a side); 0 = automatic: the paper's rule (the smallest footprint's bounding
-/// box covers at least 4 pixels), coarsened so that the footprints mark about 16 pixels each on
+/// box covers at least 4 pixels), coarsened so that the footprints mark about 4 pixels each on
 /// average: the raster only finds blocks, so a coarser one costs no exactness.
 PixelGrid make_pixel_grid(const FootprintSet& fps, double resolution_m);
 

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Blocks from pixels (paper §5) on the CPU. Each footprint marks the pixels of its closed bounding
-// box, widened by one pixel on every side: the pixel index is computed in floating point, and the
-// widening makes the marking conservative whatever that rounding does, so two footprints whose
-// closed regions meet (even at one point) always mark a common pixel. Footprints marking a common
+// box. The marking is conservative without any widening: the pixel index floor((x - origin) / res)
+// is a monotone function of x in floating point (subtraction, division by a positive number and
+// floor are all monotone under rounding), and it is the same function for every footprint, so two
+// closed intervals that meet, [a0, a1] and [b0, b1] with b0 <= a1 and a0 <= b1, get index ranges
+// that meet too. Hence two footprints whose closed regions meet (even at one point) always mark a
+// common pixel. Footprints marking a common
 // pixel are joined (union-find over (pixel, label) pairs sorted by pixel: a sparse raster, so a
 // city needs no whole-city allocation). Bounding boxes are coarser than the footprints' shapes;
 // that only merges some blocks that the union then splits into separate plans.
@@ -61,8 +64,8 @@ PixelGrid make_pixel_grid(const FootprintSet& fps, double resolution_m) {
   double res = resolution_m;
   if (!(res > 0)) {
     res = std::isfinite(smallest) ? std::sqrt(smallest / 4.0) : 1.0;  // paper §5
-    // keep the marking to ~16 pixels per footprint on average
-    const double budget = 16.0 * static_cast<double>(fps.boxes.size());
+    // keep the marking to ~4 pixels per footprint on average: the raster only groups footprints
+    const double budget = 4.0 * static_cast<double>(fps.boxes.size());
     const double coarse = std::sqrt(std::max(total_area, 1e-300) / budget);
     res = std::max(res, coarse);
   }
@@ -120,10 +123,10 @@ std::vector<Block> CpuRasterBackend::find_blocks(const FootprintSet& fps, const 
   std::size_t total = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& b = fps.boxes[i];
-    c0[i] = std::max<std::int64_t>(pix(b.minx, grid.origin_x, grid.resolution_m, grid.width) - 1, 0);
-    c1[i] = std::min<std::int64_t>(pix(b.maxx, grid.origin_x, grid.resolution_m, grid.width) + 1, grid.width - 1);
-    r0[i] = std::max<std::int64_t>(pix(b.miny, grid.origin_y, grid.resolution_m, grid.height) - 1, 0);
-    r1[i] = std::min<std::int64_t>(pix(b.maxy, grid.origin_y, grid.resolution_m, grid.height) + 1, grid.height - 1);
+    c0[i] = pix(b.minx, grid.origin_x, grid.resolution_m, grid.width);
+    c1[i] = pix(b.maxx, grid.origin_x, grid.resolution_m, grid.width);
+    r0[i] = pix(b.miny, grid.origin_y, grid.resolution_m, grid.height);
+    r1[i] = pix(b.maxy, grid.origin_y, grid.resolution_m, grid.height);
     total += static_cast<std::size_t>((c1[i] - c0[i] + 1) * (r1[i] - r0[i] + 1));
   }
   std::vector<Mark> marks;

@@ -134,20 +134,24 @@ inline ApproxDD cross_dd(const Point2& p0, const Point2& p1, const Point2& q0, c
 
 }  // namespace
 
-RungStats rung_stats() { return t_stats; }
-void reset_rung_stats() { t_stats = RungStats{}; }
+namespace detail {
+extern thread_local std::uint64_t t_cross_rung0;
+}
 
-int cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
-  const Approx a = cross_double(p0, p1, q0, q1);
-  if (a.v > a.err || -a.v > a.err) {
-    count(Family::Cross, 0);
-    return sgn(a.v);
-  }
-  // Exactly zero differences make the double result exact (common for axis-parallel walls).
-  if (a.err == 0) {
-    count(Family::Cross, 0);
-    return sgn(a.v);
-  }
+RungStats rung_stats() {
+  RungStats s = t_stats;
+  s.count[static_cast<int>(Family::Cross)][0] += detail::t_cross_rung0;
+  return s;
+}
+void reset_rung_stats() {
+  t_stats = RungStats{};
+  detail::t_cross_rung0 = 0;
+}
+
+namespace detail {
+thread_local std::uint64_t t_cross_rung0 = 0;
+
+int cross_sign_slow(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
   const ApproxDD d = cross_dd(p0, p1, q0, q1);
   const double dv = d.v.hi + d.v.lo;
   if (dv > d.err || -dv > d.err) {
@@ -187,6 +191,7 @@ int cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point
   count(Family::Cross, 2);
   return mp_cross_sign(p0, p1, q0, q1);
 }
+}  // namespace detail
 
 namespace {
 

@@ -34,8 +34,26 @@ struct RungStats {
 RungStats rung_stats();
 void reset_rung_stats();
 
-/// Sign (-1, 0, +1) of the cross product (p1 - p0) x (q1 - q0), exactly.
-int cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1);
+namespace detail {
+int cross_sign_slow(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1);
+extern thread_local std::uint64_t t_cross_rung0;  // folded into rung_stats()
+}  // namespace detail
+
+/// Sign (-1, 0, +1) of the cross product (p1 - p0) x (q1 - q0), exactly. Rung 0 is inline: the
+/// double result with Shewchuk's bound (3 + 16u)u (|t1| + |t2|); exact zero differences make the
+/// double result exact (axis-parallel walls).
+inline int cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
+  constexpr double kU = 0x1p-53;
+  const double t1 = (p1.x - p0.x) * (q1.y - q0.y);
+  const double t2 = (p1.y - p0.y) * (q1.x - q0.x);
+  const double v = t1 - t2;
+  const double err = (3.0 + 16.0 * kU) * kU * ((t1 < 0 ? -t1 : t1) + (t2 < 0 ? -t2 : t2));
+  if (v > err || -v > err || err == 0) {
+    ++detail::t_cross_rung0;
+    return (v > 0) - (v < 0);
+  }
+  return detail::cross_sign_slow(p0, p1, q0, q1);
+}
 
 /// Orientation of c relative to the directed line a->b: +1 left (counter-clockwise), -1 right, 0 on it.
 inline int orient(const Point2& a, const Point2& b, const Point2& c) { return cross_sign(a, b, a, c); }

@@ -165,19 +165,46 @@ inline bool same_way(const Point2& u0, const Point2& u1, const Point2& v0, const
   return sgn_diff(u1.x, u0.x) == sgn_diff(v1.x, v0.x) && sgn_diff(u1.y, u0.y) == sgn_diff(v1.y, v0.y);
 }
 
-/// The set of polygons with odd parity in some wedge (small: usually 0-3 entries).
+/// The set of polygons with odd parity in some wedge: usually 0-3 entries, kept inline (no heap
+/// allocation unless more than kInline polygons overlap at one point).
 struct Parity {
-  std::vector<std::uint32_t> odd;
+  static constexpr std::size_t kInline = 6;
+  std::uint32_t small[kInline];
+  std::size_t n = 0;
+  std::vector<std::uint32_t> more;  // used only when n would exceed kInline
   void toggle(std::uint32_t p) {
-    auto it = std::find(odd.begin(), odd.end(), p);
-    if (it == odd.end()) {
-      odd.push_back(p);
+    if (!more.empty() || n == kInline) {
+      if (more.empty()) more.assign(small, small + n);
+      auto it = std::find(more.begin(), more.end(), p);
+      if (it == more.end()) {
+        more.push_back(p);
+      } else {
+        *it = more.back();
+        more.pop_back();
+      }
+      n = more.size();
+      if (n < kInline) {
+        std::copy(more.begin(), more.end(), small);
+        more.clear();
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (small[i] == p) {
+        small[i] = small[--n];
+        return;
+      }
+    small[n++] = p;
+  }
+  bool inside() const { return n > 0; }
+  template <class F>
+  void for_each(F&& f) const {
+    if (!more.empty()) {
+      for (std::uint32_t p : more) f(p);
     } else {
-      *it = odd.back();
-      odd.pop_back();
+      for (std::size_t i = 0; i < n; ++i) f(small[i]);
     }
   }
-  bool inside() const { return !odd.empty(); }
 };
 
 /// The directed line of the current edge with its exact order of events.
@@ -205,12 +232,15 @@ struct Cand {
 
 struct RingOut {
   std::vector<Point2> pts;
+  bool rounded = false;  // some vertex is a rounded crossing point (else every vertex is exact input)
   std::vector<std::uint32_t> polys;  // polygons whose area borders this ring
 };
 
 struct Piece {
   Event s, t;  // ordered along the edge's own direction p0 -> p1
+  std::uint32_t next;  // next piece of the same edge, or kNone
 };
+constexpr std::uint32_t kNone = 0xffffffffu;
 
 class BlockEngine {
  public:
@@ -250,9 +280,18 @@ class BlockEngine {
   std::vector<Edge> edges_;
   std::vector<Poly> polys_;
   BoxGrid edge_grid_, poly_grid_;
-  std::vector<std::vector<Piece>> walked_;
+  std::vector<Piece> pieces_;               // walked pieces, one list per edge (no per-edge allocation)
+  std::vector<std::uint32_t> first_piece_;  // head of each edge's list, or kNone
+  std::vector<Piece> chain_scratch_;
   std::vector<RingOut> rings_;
   std::vector<Cand> scratch_cands_;
+  mutable std::vector<std::pair<int, Ray>> sort_scratch_;
+  std::vector<Ray> walk_rays_;
+  std::vector<robust::Segment> walk_segs_;
+  std::vector<std::uint32_t> walk_seg_edges_, poly_hits_;
+  std::vector<Cand> chk_cands_, chk_wcands_;
+  std::vector<Event> chk_evs_;
+  std::vector<Ray> chk_rays_, chk_wrays_;
   BlockStats stats_;
   std::size_t step_limit_ = 0;
 };
@@ -305,7 +344,8 @@ void BlockEngine::load() {
   if (edges_.empty()) return;
   edge_grid_.build(eboxes, all, edges_.size() / 2 + 1);
   poly_grid_.build(pboxes, all, polys_.size() + 1);
-  walked_.assign(edges_.size(), {});
+  first_piece_.assign(edges_.size(), kNone);
+  pieces_.reserve(edges_.size() + 16);
   step_limit_ = 16 * edges_.size() + 1024;
 }
 
@@ -436,8 +476,8 @@ int BlockEngine::ray_class(const Point2& r0, const Point2& r1, const Ray& d) con
 }
 
 void BlockEngine::sort_rays(const Point2& r0, const Point2& r1, std::vector<Ray>& rays) const {
-  std::vector<std::pair<int, Ray>> k;
-  k.reserve(rays.size());
+  std::vector<std::pair<int, Ray>>& k = sort_scratch_;
+  k.clear();
   for (const Ray& r : rays) k.emplace_back(ray_class(r0, r1, r), r);
   std::stable_sort(k.begin(), k.end(), [&](const auto& x, const auto& y) {
     if (x.first != y.first) return x.first < y.first;
@@ -494,7 +534,8 @@ void BlockEngine::mark(const std::vector<Ray>& group, const Line& L, const Event
     const Edge& h = edges_[r.edge];
     // store ordered along h's own direction: same way as L or opposite
     const bool same = same_way(L.a, L.b, h.p0, h.p1);
-    walked_[r.edge].push_back(same ? Piece{s, t} : Piece{t, s});
+    pieces_.push_back(same ? Piece{s, t, first_piece_[r.edge]} : Piece{t, s, first_piece_[r.edge]});
+    first_piece_[r.edge] = static_cast<std::uint32_t>(pieces_.size() - 1);
   }
 }
 
@@ -504,10 +545,9 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
   RingOut ring;
   Event cur = start;
   std::vector<Cand>& cands = scratch_cands_;
-  std::vector<Ray> rays;
-  std::vector<Event> vertex_events;
-  std::vector<robust::Segment> segs;
-  std::vector<std::uint32_t> seg_edges;
+  std::vector<Ray>& rays = walk_rays_;
+  std::vector<robust::Segment>& segs = walk_segs_;
+  std::vector<std::uint32_t>& seg_edges = walk_seg_edges_;
   for (std::size_t step = 0;; ++step) {
     if (step > step_limit_) {
       const Point2 p = point_of(L, cur);
@@ -544,8 +584,9 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
       // members: polygons entered by the group we are walking along
       Parity pg;
       for (const Ray& r : group) pg.toggle(r.poly);
-      for (std::uint32_t p : pg.odd)
+      pg.for_each([&](std::uint32_t p) {
         if (std::find(ring.polys.begin(), ring.polys.end(), p) == ring.polys.end()) ring.polys.push_back(p);
+      });
     }
     mark(group, L, cur, x0);
     rays_at(L, x0, cands, rays);
@@ -564,6 +605,7 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     // every event point is kept here: a straight run may pass a point the walk turns at later
     // (the ring touches itself there); split_simple needs to see it, then drops straight vertices
     ring.pts.push_back(point_of(L, x0));
+    ring.rounded |= x0.cross;
     group.assign(rays.begin() + static_cast<std::ptrdiff_t>(g0), rays.begin() + static_cast<std::ptrdiff_t>(g1));
     L = Line(out.edge, out.from, out.to);
     cur = next;
@@ -578,15 +620,23 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
 
 // ------------------------------------------------------------------------------------------------
 bool BlockEngine::walked(std::uint32_t e, const Line& L, const Event& s, const Event& t) const {
-  for (const Piece& p : walked_[e])
-    if (cmp(L, p.s, s) == 0 && cmp(L, p.t, t) == 0) return true;
+  for (std::uint32_t k = first_piece_[e]; k != kNone; k = pieces_[k].next)
+    if (cmp(L, pieces_[k].s, s) == 0 && cmp(L, pieces_[k].t, t) == 0) return true;
   return false;
 }
 
 bool BlockEngine::fully_walked(std::uint32_t e) {
-  auto& w = walked_[e];
-  if (w.empty()) return false;
+  if (first_piece_[e] == kNone) return false;
   const Line L(e, edges_[e].p0, edges_[e].p1);
+  {
+    // the common case: one piece, the whole edge
+    const Piece& p = pieces_[first_piece_[e]];
+    if (p.next == kNone) return !p.s.cross && !p.t.cross && p.s.v == L.a && p.t.v == L.b;
+  }
+  auto& w = chain_scratch_;
+  w.clear();
+  for (std::uint32_t k = first_piece_[e]; k != kNone; k = pieces_[k].next) w.push_back(pieces_[k]);
+
   std::sort(w.begin(), w.end(), [&](const Piece& x, const Piece& y) { return cmp(L, x.s, y.s) < 0; });
   const Event a{false, L.a, 0}, b{false, L.b, 0};
   if (cmp(L, w.front().s, a) != 0) return false;
@@ -603,7 +653,8 @@ Parity BlockEngine::parity_at_vertex_wedge0(const Point2& p) {
   Parity par;
   Box pb;
   pb.add(p);
-  std::vector<std::uint32_t> hits;
+  std::vector<std::uint32_t>& hits = poly_hits_;
+  hits.clear();
   poly_grid_.query(pb, [&](std::uint32_t pi) {
     if (polys_[pi].box.contains(p)) hits.push_back(pi);
   });
@@ -628,10 +679,11 @@ void BlockEngine::check_edge(std::uint32_t e) {
   ++stats_.edges_checked;
   const Edge E = edges_[e];
   const Line L(e, E.p0, E.p1);
-  std::vector<Cand> cands;
+  std::vector<Cand>& cands = chk_cands_;
   scan(L, cands);
   // all events strictly inside, exactly ordered and deduplicated
-  std::vector<Event> evs;
+  std::vector<Event>& evs = chk_evs_;
+  evs.clear();
   const Event A{false, L.a, 0}, B{false, L.b, 0};
   for (const Cand& c : cands) {
     for (int w = 0; w < (c.kind == Cand::Collinear ? 2 : 1); ++w) {
@@ -651,7 +703,7 @@ void BlockEngine::check_edge(std::uint32_t e) {
   if (!any_open) return;
 
   // Parity on both sides at a: ray cast into the wedge above +x, then sweep to the edge.
-  std::vector<Ray> rays;
+  std::vector<Ray>& rays = chk_rays_;
   rays_at(L, A, cands, rays);
   Parity state = parity_at_vertex_wedge0(L.a);
   const Point2 o{0, 0}, xaxis{1, 0};
@@ -695,9 +747,10 @@ void BlockEngine::check_edge(std::uint32_t e) {
     const bool fwd = left.inside();
     const Line W = fwd ? L : Line(e, L.b, L.a);
     const Event s = fwd ? evs[i] : evs[i + 1];
-    std::vector<Cand> wc;
+    std::vector<Cand>& wc = chk_wcands_;
     scan(W, wc);
-    std::vector<Ray> wr, group;
+    std::vector<Ray>& wr = chk_wrays_;
+    std::vector<Ray> group;
     rays_at(W, s, wc, wr);
     for (const Ray& r : wr)
       if (cross_sign(W.a, W.b, r.from, r.to) == 0 && same_way(W.a, W.b, r.from, r.to)) group.push_back(r);
@@ -1032,7 +1085,7 @@ void BlockEngine::assemble(BlockResult& out) {
     for (const Point2& p : rings_[i].pts)
       if (w.empty() || !(w.back() == p)) w.push_back(p);
     while (w.size() > 1 && w.front() == w.back()) w.pop_back();
-    if (!node_walk(w))
+    if (rings_[i].rounded && !node_walk(w))
       out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
                                      "a boundary crosses itself after rounding by more than rounding error"});
     split_simple(w, parts);
@@ -1104,7 +1157,10 @@ void BlockEngine::assemble(BlockResult& out) {
       g.polygon.holes.push_back(std::move(holes[h].pts));
     }
     // Rounded output must stay valid (issue 3): check exactly, repair rounding slivers locally.
-    {
+    // A plan whose vertices are all input vertices is the exact boundary: nothing to check.
+    bool rounded = rings_[outers[k].src].rounded;
+    for (std::size_t h : holes_of[k]) rounded |= rings_[holes[h].src].rounded;
+    if (rounded) {
       std::vector<std::vector<Point2>*> rr{&g.polygon.outer};
       for (Ring& h : g.polygon.holes) rr.push_back(&h);
       Conflict c{};

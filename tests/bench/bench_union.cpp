@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: MIT
+// Union benchmark (issue 3): this engine against GEOS UnaryUnion (and GEOSCoverageUnion where the
+// input is a valid coverage) on identical synthetic footprints, in one process per (engine, size)
+// so that peak memory (getrusage ru_maxrss) belongs to one engine.
+//
+//   bench_union --n 6000 --engine ours|geos|coverage [--runs 5] [--seed 1] [--threads 0] [--coverage]
+// prints one line: engine n runs median_s min_s max_s plans peak_rss_mib input_rss_mib
+// tests/bench/run_bench.sh runs the whole matrix and prints ratios.
+#include <groundplan/gis/geos_reference.h>
+#include <groundplan/ground_plans.h>
+
+#include <geos_c.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "union_generators.h"
+
+namespace {
+
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+void quiet(const char*, ...) {}
+
+/// GEOS CoverageUnion (GEOS >= 3.8) of all footprint polygons; returns the number of polygons.
+std::size_t geos_coverage_union(const std::vector<groundplan::Footprint>& fps) {
+  GEOSContextHandle_t h = GEOS_init_r();
+  GEOSContext_setNoticeHandler_r(h, quiet);
+  GEOSContext_setErrorHandler_r(h, quiet);
+  std::vector<GEOSGeometry*> polys;
+  for (const auto& f : fps)
+    for (const auto& p : f.polygons) {
+      auto ring = [&](const groundplan::Ring& r) {
+        GEOSCoordSequence* s = GEOSCoordSeq_create_r(h, static_cast<unsigned>(r.size() + 1), 2);
+        for (std::size_t i = 0; i <= r.size(); ++i)
+          GEOSCoordSeq_setXY_r(h, s, static_cast<unsigned>(i), r[i % r.size()].x, r[i % r.size()].y);
+        return GEOSGeom_createLinearRing_r(h, s);
+      };
+      std::vector<GEOSGeometry*> holes;
+      for (const auto& hr : p.holes) holes.push_back(ring(hr));
+      polys.push_back(GEOSGeom_createPolygon_r(h, ring(p.outer), holes.data(), static_cast<unsigned>(holes.size())));
+    }
+  GEOSGeometry* coll =
+      GEOSGeom_createCollection_r(h, GEOS_MULTIPOLYGON, polys.data(), static_cast<unsigned>(polys.size()));
+  GEOSGeometry* u = GEOSCoverageUnion_r(h, coll);
+  std::size_t n = u ? static_cast<std::size_t>(GEOSGetNumGeometries_r(h, u)) : 0;
+  if (u) GEOSGeom_destroy_r(h, u);
+  GEOSGeom_destroy_r(h, coll);
+  GEOS_finish_r(h);
+  return n;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::size_t n = 6000;
+  std::string engine = "ours";
+  int runs = 5, threads = 0;
+  std::uint64_t seed = 1;
+  bool coverage = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : ""; };
+    if (a == "--n") n = std::strtoull(next(), nullptr, 10);
+    else if (a == "--engine") engine = next();
+    else if (a == "--runs") runs = std::atoi(next());
+    else if (a == "--seed") seed = std::strtoull(next(), nullptr, 10);
+    else if (a == "--threads") threads = std::atoi(next());
+    else if (a == "--coverage") coverage = true;
+    else {
+      std::fprintf(stderr, "usage: %s --n N --engine ours|geos|coverage [--runs R] [--seed S] [--threads T] [--coverage]\n", argv[0]);
+      return 2;
+    }
+  }
+  const auto fps = groundplan::testing::synthetic_city(n, seed, coverage);
+  const double input_rss = peak_rss_mib();
+  std::vector<double> t;
+  std::size_t plans = 0;
+  for (int r = 0; r < runs; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (engine == "ours") {
+      groundplan::UnionParams p;
+      p.threads = threads;
+      std::vector<groundplan::Problem> problems;
+      plans = groundplan::build_ground_plans(fps, p, problems).size();
+    } else if (engine == "geos") {
+      plans = groundplan::gis::geos_union(fps).size();
+    } else if (engine == "coverage") {
+      plans = geos_coverage_union(fps);
+    } else {
+      std::fprintf(stderr, "unknown engine %s\n", engine.c_str());
+      return 2;
+    }
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(t.begin(), t.end());
+  std::printf("%s %zu %d %.6f %.6f %.6f %zu %.1f %.1f\n", engine.c_str(), fps.size(), runs, t[t.size() / 2], t.front(),
+              t.back(), plans, peak_rss_mib(), input_rss);
+  return 0;
+}
