@@ -4,7 +4,8 @@
 // so that peak memory (getrusage ru_maxrss) belongs to one engine.
 //
 //   bench_union --n 6000 --engine ours|geos|coverage [--runs 5] [--seed 1] [--threads 0] [--coverage]
-// prints one line: engine n runs median_s min_s max_s plans peak_rss_mib input_rss_mib
+// prints one line: engine n runs median_wall_s min_wall_s max_wall_s median_cpu_s plans peak_rss_mib
+// input_rss_mib (input_rss: after generating the footprints, before the first union)
 // tests/bench/run_bench.sh runs the whole matrix and prints ratios.
 #include <groundplan/gis/geos_reference.h>
 #include <groundplan/ground_plans.h>
@@ -23,6 +24,13 @@
 #include "union_generators.h"
 
 namespace {
+
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 double peak_rss_mib() {
   rusage u{};
@@ -84,10 +92,11 @@ int main(int argc, char** argv) {
   }
   const auto fps = groundplan::testing::synthetic_city(n, seed, coverage);
   const double input_rss = peak_rss_mib();
-  std::vector<double> t;
+  std::vector<double> t, cpu;
   std::size_t plans = 0;
   for (int r = 0; r < runs; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_seconds();
     if (engine == "ours") {
       groundplan::UnionParams p;
       p.threads = threads;
@@ -102,9 +111,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    cpu.push_back(cpu_seconds() - c0);
   }
   std::sort(t.begin(), t.end());
-  std::printf("%s %zu %d %.6f %.6f %.6f %zu %.1f %.1f\n", engine.c_str(), fps.size(), runs, t[t.size() / 2], t.front(),
-              t.back(), plans, peak_rss_mib(), input_rss);
+  std::sort(cpu.begin(), cpu.end());
+  std::printf("%s %zu %d %.6f %.6f %.6f %.6f %zu %.1f %.1f\n", engine.c_str(), fps.size(), runs, t[t.size() / 2],
+              t.front(), t.back(), cpu[cpu.size() / 2], plans, peak_rss_mib(), input_rss);
   return 0;
 }

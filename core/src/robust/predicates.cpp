@@ -152,41 +152,36 @@ namespace detail {
 thread_local std::uint64_t t_cross_rung0 = 0;
 
 int cross_sign_slow(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
+  // Rung 1. When the four differences are exact doubles (the usual case: Sterbenz for nearby
+  // coordinates) the determinant is the exact sum of two two_prod pairs, and summing those four
+  // terms with two_sum is exact: the sign is certain, exact zeros included (collinear vertices on a
+  // party wall), without MPFR. Otherwise double-double arithmetic with its certified bound.
+  const DD dx1 = two_diff(p1.x, p0.x), dy1 = two_diff(p1.y, p0.y);
+  const DD dx2 = two_diff(q1.x, q0.x), dy2 = two_diff(q1.y, q0.y);
+  if (dx1.lo == 0 && dy1.lo == 0 && dx2.lo == 0 && dy2.lo == 0) {
+    const DD t1 = two_prod(dx1.hi, dy2.hi), t2 = two_prod(dy1.hi, dx2.hi);
+    double e[4] = {t1.lo, -t2.lo, t1.hi, -t2.hi};
+    std::sort(e, e + 4, [](double x, double y) { return std::fabs(x) < std::fabs(y); });
+    double q = e[0];
+    double h[4];
+    int nh = 0;
+    for (int i = 1; i < 4; ++i) {
+      const DD s2 = two_sum(q, e[i]);
+      if (s2.lo != 0) h[nh++] = s2.lo;
+      q = s2.hi;
+    }
+    h[nh++] = q;
+    count(Family::Cross, 1);
+    // non-overlapping components in increasing magnitude: the largest non-zero one gives the sign
+    for (int i = nh - 1; i >= 0; --i)
+      if (h[i] != 0) return sgn(h[i]);
+    return 0;
+  }
   const ApproxDD d = cross_dd(p0, p1, q0, q1);
   const double dv = d.v.hi + d.v.lo;
   if (dv > d.err || -dv > d.err) {
     count(Family::Cross, 1);
     return sgn(d.v.hi);
-  }
-  {
-    // Still rung 1: when the four differences are exact doubles (the usual case) the determinant is
-    // the exact sum of two two_prod pairs; summing those four terms with two_sum is exact, so exact
-    // zeros (collinear vertices on a party wall) are certified without MPFR.
-    const DD dx1 = two_diff(p1.x, p0.x), dy1 = two_diff(p1.y, p0.y);
-    const DD dx2 = two_diff(q1.x, q0.x), dy2 = two_diff(q1.y, q0.y);
-    if (dx1.lo == 0 && dy1.lo == 0 && dx2.lo == 0 && dy2.lo == 0) {
-      const DD t1 = two_prod(dx1.hi, dy2.hi), t2 = two_prod(dy1.hi, dx2.hi);
-      // exact expansion of t1.hi + t1.lo - t2.hi - t2.lo (Shewchuk's grow-expansion, 4 terms)
-      double e[4] = {t1.lo, -t2.lo, t1.hi, -t2.hi};
-      std::sort(e, e + 4, [](double x, double y) { return std::fabs(x) < std::fabs(y); });
-      double q = e[0];
-      double h[4];
-      int nh = 0;
-      for (int i = 1; i < 4; ++i) {
-        const DD s2 = two_sum(q, e[i]);
-        if (s2.lo != 0) h[nh++] = s2.lo;
-        q = s2.hi;
-      }
-      h[nh++] = q;
-      // the components are non-overlapping and increasing: the sign is that of the largest non-zero
-      for (int i = nh - 1; i >= 0; --i)
-        if (h[i] != 0) {
-          count(Family::Cross, 1);
-          return sgn(h[i]);
-        }
-      count(Family::Cross, 1);
-      return 0;
-    }
   }
   count(Family::Cross, 2);
   return mp_cross_sign(p0, p1, q0, q1);

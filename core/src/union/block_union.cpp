@@ -105,7 +105,8 @@ class BoxGrid {
     for (const Box& b : boxes) for_cells(b, [&](std::size_t k) { ++start_[k + 1]; });
     for (std::size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
     items_.resize(start_.back());
-    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    fill_.assign(start_.begin(), start_.end() - 1);
+    std::vector<std::uint32_t>& fill = fill_;
     for (std::uint32_t i = 0; i < boxes.size(); ++i) for_cells(boxes[i], [&](std::size_t k) { items_[fill[k]++] = i; });
     stamp_.assign(boxes.size(), 0);
   }
@@ -138,7 +139,7 @@ class BoxGrid {
   }
   double ox_ = 0, oy_ = 0, ix_ = 1, iy_ = 1;
   int nx_ = 1, ny_ = 1;
-  std::vector<std::uint32_t> start_, items_, stamp_;
+  std::vector<std::uint32_t> start_, items_, stamp_, fill_;
   std::uint32_t epoch_ = 0;
 };
 
@@ -244,8 +245,19 @@ constexpr std::uint32_t kNone = 0xffffffffu;
 
 class BlockEngine {
  public:
-  BlockEngine(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members)
-      : footprints_(footprints), members_(members) {}
+  BlockEngine() = default;
+  /// Prepares for one block, keeping the capacity of every buffer (one engine per thread).
+  void reset(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members) {
+    footprints_ = &footprints;
+    members_ = &members;
+    edges_.clear();
+    polys_.clear();
+    pieces_.clear();
+    first_piece_.clear();
+    rings_.clear();
+    stats_ = BlockStats{};
+    step_limit_ = 0;
+  }
 
   BlockResult run();
 
@@ -275,16 +287,19 @@ class BlockEngine {
   // --- output
   void assemble(BlockResult& out);
 
-  const std::vector<Footprint>& footprints_;
-  const std::vector<std::uint32_t>& members_;
+  const std::vector<Footprint>* footprints_ = nullptr;
+  const std::vector<std::uint32_t>* members_ = nullptr;
+  std::vector<Box> eboxes_, pboxes_;
   std::vector<Edge> edges_;
   std::vector<Poly> polys_;
   BoxGrid edge_grid_, poly_grid_;
   std::vector<Piece> pieces_;               // walked pieces, one list per edge (no per-edge allocation)
   std::vector<std::uint32_t> first_piece_;  // head of each edge's list, or kNone
   std::vector<Piece> chain_scratch_;
+  std::vector<std::uint8_t> checked_;  // edges proven by the check of an exact twin
   std::vector<RingOut> rings_;
   std::vector<Cand> scratch_cands_;
+  std::vector<Point2> load_ring_;
   mutable std::vector<std::pair<int, Ray>> sort_scratch_;
   std::vector<Ray> walk_rays_;
   std::vector<robust::Segment> walk_segs_;
@@ -298,11 +313,14 @@ class BlockEngine {
 
 // ------------------------------------------------------------------------------------------------
 void BlockEngine::load() {
-  std::vector<Box> eboxes, pboxes;
+  std::vector<Box>& eboxes = eboxes_;
+  std::vector<Box>& pboxes = pboxes_;
+  eboxes.clear();
+  pboxes.clear();
   Box all;
-  std::vector<Point2> ring;
-  for (std::uint32_t fi : members_) {
-    for (const Polygon& poly : footprints_[fi].polygons) {
+  std::vector<Point2>& ring = load_ring_;
+  for (std::uint32_t fi : *members_) {
+    for (const Polygon& poly : (*footprints_)[fi].polygons) {
       Poly P{fi, static_cast<std::uint32_t>(edges_.size()), 0, Box{}, false};
       const auto pid = static_cast<std::uint32_t>(polys_.size());
       auto add_ring = [&](const Ring& r) {
@@ -345,6 +363,7 @@ void BlockEngine::load() {
   edge_grid_.build(eboxes, all, edges_.size() / 2 + 1);
   poly_grid_.build(pboxes, all, polys_.size() + 1);
   first_piece_.assign(edges_.size(), kNone);
+  checked_.assign(edges_.size(), 0);
   pieces_.reserve(edges_.size() + 16);
   step_limit_ = 16 * edges_.size() + 1024;
 }
@@ -479,13 +498,20 @@ void BlockEngine::sort_rays(const Point2& r0, const Point2& r1, std::vector<Ray>
   std::vector<std::pair<int, Ray>>& k = sort_scratch_;
   k.clear();
   for (const Ray& r : rays) k.emplace_back(ray_class(r0, r1, r), r);
-  std::stable_sort(k.begin(), k.end(), [&](const auto& x, const auto& y) {
+  auto less = [&](const std::pair<int, Ray>& x, const std::pair<int, Ray>& y) {
     if (x.first != y.first) return x.first < y.first;
     if (x.first == 1 || x.first == 3) return x.second.edge < y.second.edge;
     const int c = cross_sign(x.second.from, x.second.to, y.second.from, y.second.to);
     if (c != 0) return c > 0;
     return x.second.edge < y.second.edge;
-  });
+  };
+  if (k.size() <= 12) {
+    // a handful of rays meet at a vertex: insertion sort, no allocation
+    for (std::size_t i = 1; i < k.size(); ++i)
+      for (std::size_t j = i; j > 0 && less(k[j], k[j - 1]); --j) std::swap(k[j], k[j - 1]);
+  } else {
+    std::stable_sort(k.begin(), k.end(), less);
+  }
   for (std::size_t i = 0; i < rays.size(); ++i) rays[i] = k[i].second;
 }
 
@@ -675,7 +701,7 @@ Parity BlockEngine::parity_at_vertex_wedge0(const Point2& p) {
 }
 
 void BlockEngine::check_edge(std::uint32_t e) {
-  if (fully_walked(e)) return;
+  if (checked_[e] || fully_walked(e)) return;
   ++stats_.edges_checked;
   const Edge E = edges_[e];
   const Line L(e, E.p0, E.p1);
@@ -691,6 +717,14 @@ void BlockEngine::check_edge(std::uint32_t e) {
       if (!ev.cross && !L.within(ev.v)) continue;
       if (cmp(L, ev, A) > 0 && cmp(L, ev, B) < 0) evs.push_back(ev);
     }
+  }
+  // An exact twin (same segment, another polygon or ring: party walls) has exactly these pieces,
+  // and every boundary piece found below is walked for all edges of its collinear group, so the
+  // twin needs no check of its own.
+  for (const Cand& c : cands) {
+    if (c.kind != Cand::Collinear) continue;
+    const Edge& f = edges_[c.edge];
+    if ((f.p0 == E.p0 && f.p1 == E.p1) || (f.p0 == E.p1 && f.p1 == E.p0)) checked_[c.edge] = 1;
   }
   std::sort(evs.begin(), evs.end(), [&](const Event& x, const Event& y) { return cmp(L, x, y) < 0; });
   evs.erase(std::unique(evs.begin(), evs.end(), [&](const Event& x, const Event& y) { return cmp(L, x, y) == 0; }),
@@ -1004,7 +1038,6 @@ void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point
       return std::hash<std::uint64_t>()(a * 0x9E3779B97F4A7C15ull ^ b);
     }
   };
-  std::unordered_map<Point2, std::size_t, H> pos;
   std::vector<Point2> stack;
   auto emit = [&](std::vector<Point2> r) {
     // remove spikes a-b-a left by rounding
@@ -1053,6 +1086,17 @@ void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point
     }
     if (r.size() >= 3) out.push_back(std::move(r));
   };
+  {
+    // the common case: no vertex repeats, so the walk is one simple ring
+    std::vector<Point2> sorted(pts);
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) {
+      emit(std::move(pts));
+      return;
+    }
+  }
+  std::unordered_map<Point2, std::size_t, H> pos;
   for (const Point2& p : pts) {
     auto it = pos.find(p);
     if (it != pos.end()) {
@@ -1228,7 +1272,8 @@ BlockResult BlockEngine::run() {
 }  // namespace
 
 BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members) {
-  BlockEngine engine(footprints, members);
+  thread_local BlockEngine engine;
+  engine.reset(footprints, members);
   return engine.run();
 }
 
