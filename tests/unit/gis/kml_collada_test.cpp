@@ -495,6 +495,9 @@ TEST(Kml, OrderCommentsNamespacesMultiGeometryAndIds) {
   EXPECT_NEAR(bbox(r.meshes[0]).dz(), 2.0, 1e-3) << "Scale z read after a comment, out of order";
   // 1.02 from UTM 52N's grid convergence (-1.1° here); the LookAt's heading 45 would give 1.41.
   EXPECT_NEAR(bbox(r.meshes[0]).dx(), 1.0, 0.05) << "LookAt heading must not rotate the model";
+  // Latitude "37.6<!-- x -->2" is 37.62: both models within a few hundred metres of each other.
+  const Bbox b0 = bbox(r.meshes[0]), b1 = bbox(r.meshes[1]);
+  EXPECT_LT(std::hypot(b0.x0 - b1.x0, b0.y0 - b1.y0), 300.0);
   EXPECT_EQ(r.count("NO_LINK"), 1u);
   EXPECT_EQ(r.count("NO_LOCATION"), 1u);
   EXPECT_EQ(r.info.kml.placemarks, 3u);
