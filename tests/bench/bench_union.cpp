@@ -4,6 +4,7 @@
 // so that peak memory (getrusage ru_maxrss) belongs to one engine.
 //
 //   bench_union --n 6000 --engine ours|geos|coverage [--runs 5] [--seed 1] [--threads 0] [--coverage]
+//   bench_union --n 6000 --verify [--coverage]     (compare our plans with GEOS UnaryUnion, exit 1 if not)
 // prints one line: engine n runs median_wall_s min_wall_s max_wall_s median_cpu_s plans peak_rss_mib
 // input_rss_mib (input_rss: after generating the footprints, before the first union)
 // tests/bench/run_bench.sh runs the whole matrix and prints ratios.
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
   std::string engine = "ours";
   int runs = 5, threads = 0;
   std::uint64_t seed = 1;
-  bool coverage = false;
+  bool coverage = false, verify = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : ""; };
@@ -85,6 +86,7 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::strtoull(next(), nullptr, 10);
     else if (a == "--threads") threads = std::atoi(next());
     else if (a == "--coverage") coverage = true;
+    else if (a == "--verify") verify = true;
     else {
       std::fprintf(stderr, "usage: %s --n N --engine ours|geos|coverage [--runs R] [--seed S] [--threads T] [--coverage]\n", argv[0]);
       return 2;
@@ -92,6 +94,16 @@ int main(int argc, char** argv) {
   }
   const auto fps = groundplan::testing::synthetic_city(n, seed, coverage);
   const double input_rss = peak_rss_mib();
+  if (verify) {
+    // correctness of our result on this input against GEOS UnaryUnion (DESIGN.md criterion)
+    groundplan::UnionParams p;
+    std::vector<groundplan::Problem> problems;
+    const auto plans = groundplan::build_ground_plans(fps, p, problems);
+    const auto c = groundplan::gis::compare_with_geos(fps, plans);
+    std::printf("verify n=%zu matches=%d problems=%zu: %s\n", fps.size(), c.matches(1e-9) ? 1 : 0, problems.size(),
+                c.summary().c_str());
+    return c.matches(1e-9) ? 0 : 1;
+  }
   std::vector<double> t, cpu;
   std::size_t plans = 0;
   for (int r = 0; r < runs; ++r) {
