@@ -27,6 +27,7 @@
 #include <map>
 #include <memory>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 namespace groundplan::gis {
@@ -170,6 +171,14 @@ Attrs scan_attrs(const char** atts) {
   return a;
 }
 
+/// srsDimension "2" or "3" (spaces around allowed) -> 2 or 3; anything else (a claim of 1e9 dimensions,
+/// a negative or a non-number) -> 0.
+int srs_dimension_value(std::string_view v) {
+  while (!v.empty() && (v.front() == ' ' || v.front() == '\t' || v.front() == '\n' || v.front() == '\r')) v.remove_prefix(1);
+  while (!v.empty() && (v.back() == ' ' || v.back() == '\t' || v.back() == '\n' || v.back() == '\r')) v.remove_suffix(1);
+  return v == "2" ? 2 : v == "3" ? 3 : 0;
+}
+
 /// "lod2Solid" -> lod 2, surface geometry; "lod2TerrainIntersection" -> skip. Returns false if not lodN*.
 bool parse_lod_property(std::string_view local, std::uint8_t& lod, Tag& tag, SurfaceKind& kind) {
   if (local.size() < 5 || !local.starts_with("lod") || local[3] < '0' || local[3] > '4') return false;
@@ -211,6 +220,7 @@ struct BuildingCtx {
   std::size_t depth = 0;
   bool is_part = false;
   bool has_parts = false;
+  std::string foreign_gml_ns;  // first namespace URI of a GML-named element (Polygon, posList ...) that is not GML's
   // code -> (count, first reason): one Problem per code per building
   std::map<std::string, std::pair<std::size_t, std::string>> defects;
 
@@ -280,6 +290,7 @@ class Reader {
     XML_SetParamEntityParsing(parser_, XML_PARAM_ENTITY_PARSING_NEVER);
     XML_SetEntityDeclHandler(parser_, &Reader::on_entity_decl);
     XML_SetUnparsedEntityDeclHandler(parser_, &Reader::on_unparsed_entity_decl);
+    XML_SetStartDoctypeDeclHandler(parser_, &Reader::on_doctype);
     frames_.reserve(64);
     frames_.push_back(Frame{});
   }
@@ -330,9 +341,13 @@ class Reader {
  private:
   void parse_buffer(std::size_t n, bool last) {
     info_.bytes += n;
+    if (last && info_.bytes == 0) throw InputError(name_ + ": the file is empty (0 bytes): nothing to read");
     XML_Status st = XML_ParseBuffer(parser_, static_cast<int>(n), last ? XML_TRUE : XML_FALSE);
     if (pending_exception_) std::rethrow_exception(pending_exception_);
-    if (!stop_reason_.empty()) throw InputError(name_ + ": " + stop_reason_);
+    if (!stop_reason_.empty()) {
+      salvage(stop_reason_);
+      throw InputError(name_ + ": " + stop_reason_);
+    }
     if (st != XML_STATUS_OK) {
       XML_Error code = XML_GetErrorCode(parser_);
       std::string msg = name_ + ": not well-formed XML at line " + std::to_string(XML_GetCurrentLineNumber(parser_)) +
@@ -343,8 +358,35 @@ class Reader {
         msg += " (the file looks truncated; buildings before this point were read)";
       else
         msg += " (is this a CityGML file?)";
+      salvage(std::string("the XML breaks off (") + XML_ErrorString(code) + " at line " +
+              std::to_string(XML_GetCurrentLineNumber(parser_)) + ")");
       throw InputError(msg);
     }
+  }
+
+  /// Reading stops early (truncated or refused file): what is complete still goes out (buildings held
+  /// back for a forward xlink), and every building open at that point is named by a Problem TRUNCATED,
+  /// so that none is lost silently (issue 8). Deeply nested hostile input may hold hundreds of open
+  /// buildings: past kMaxNamed the rest are counted in the last Problem's reason, not listed.
+  void salvage(const std::string& why) {
+    while (!pending_.empty()) {
+      auto ctx = std::move(pending_.front());
+      pending_.pop_front();
+      give_up_refs(*ctx);
+      deliver(std::move(ctx));
+    }
+    constexpr std::size_t kMaxNamed = 4;
+    const std::size_t open = buildings_.size();
+    for (std::size_t k = 0; k < open && k < kMaxNamed; ++k) {
+      const BuildingCtx& b = *buildings_[k];
+      std::string reason = std::string(b.is_part ? "BuildingPart" : "Building") + " is incomplete: " + why +
+                           " inside it; it is not used";
+      if (k + 1 == kMaxNamed && open > kMaxNamed)
+        reason += " (and " + std::to_string(open - kMaxNamed) + " more buildings nested in it)";
+      problems_.push_back(Problem{b.mesh.source_id, name_, "read", "TRUNCATED", reason});
+      ++info_.buildings_dropped;
+    }
+    buildings_.clear();
   }
 
   void stop(std::string reason) {
@@ -362,6 +404,17 @@ class Reader {
   static void XMLCALL on_unparsed_entity_decl(void* ud, const XML_Char* name, const XML_Char*, const XML_Char*,
                                               const XML_Char*, const XML_Char*) {
     on_entity_decl(ud, name, 0, nullptr, 0, nullptr, nullptr, nullptr, nullptr);
+  }
+
+  static void XMLCALL on_doctype(void* ud, const XML_Char* name, const XML_Char* sysid, const XML_Char* pubid, int) {
+    // An external DTD is never loaded (no external entity handler, parameter entities off): say so,
+    // since a document that needs its DTD (default attributes, entities) reads differently here.
+    if (!sysid && !pubid) return;
+    auto* self = static_cast<Reader*>(ud);
+    self->problems_.push_back(Problem{"", self->name_, "read", "NOTE",
+                                      std::string("the document names an external DTD (\"") +
+                                          std::string(sysid ? sysid : pubid).substr(0, 120) +
+                                          "\"); it is never loaded"});
   }
 
   static void XMLCALL on_start(void* ud, const XML_Char* name, const XML_Char** atts) {
@@ -383,13 +436,21 @@ class Reader {
     }
   }
   static void XMLCALL on_text(void* ud, const XML_Char* s, int len) {
-    static_cast<Reader*>(ud)->text_.append(s, static_cast<std::size_t>(len));
+    auto* self = static_cast<Reader*>(ud);
+    // Bounded whatever the document claims or holds (issue 8: a "2 GB coordinate list").
+    const std::size_t n = static_cast<std::size_t>(len);
+    if (self->text_.size() + n > self->opt_.max_coordinate_chars) {
+      self->text_overflow_ = true;
+      return;
+    }
+    self->text_.append(s, n);
   }
 
   void begin_capture(Capture c) {
     capture_ = c;
     capture_depth_ = frames_.size() + 1;  // called from start(), before its frame is pushed
     text_.clear();
+    text_overflow_ = false;
     XML_SetCharacterDataHandler(parser_, &Reader::on_text);
   }
   void end_capture() {
@@ -418,14 +479,15 @@ class Reader {
     f.tag = Tag::None;
     Attrs a = atts[0] ? scan_attrs(atts) : Attrs{};
     if (a.srs_name) note_srs(a.srs_name);
+    BuildingCtx* b = building();
     if (a.srs_dimension) {
-      int d = std::atoi(a.srs_dimension);
-      if (d == 2 || d == 3) {
+      if (const int d = srs_dimension_value(a.srs_dimension)) {
         f.dim = static_cast<std::uint8_t>(d);
         if (!info_.srs_dimension) info_.srs_dimension = d;
+      } else {
+        bad_srs_dimension(b, a.srs_dimension);
       }
     }
-    BuildingCtx* b = building();
 
     if (ns == Ns::CityGml) {
       if (info_.citygml_version.empty()) note_version(std::string_view(name, static_cast<std::size_t>(sp - name)));
@@ -466,6 +528,8 @@ class Reader {
         default:
           break;
       }
+    } else if (ns == Ns::Other && b && b->foreign_gml_ns.empty() && gml_tags().count(local)) {
+      b->foreign_gml_ns = std::string(name, static_cast<std::size_t>(sp - name));
     } else if (ns == Ns::Gml) {
       auto it = gml_tags().find(local);
       Tag t = it == gml_tags().end() ? Tag::None : it->second;
@@ -491,7 +555,7 @@ class Reader {
           case Tag::Pos:
           case Tag::Coordinates:
             if (in_ring_) {
-              coord_dim_attr_ = a.srs_dimension ? std::atoi(a.srs_dimension) : 0;
+              coord_dim_attr_ = a.srs_dimension ? srs_dimension_value(a.srs_dimension) : 0;
               cs_ = a.cs && *a.cs ? a.cs[0] : ',';
               ts_ = a.ts && *a.ts ? a.ts[0] : ' ';
               decimal_ = a.decimal && *a.decimal ? a.decimal[0] : '.';
@@ -612,6 +676,17 @@ class Reader {
     }
   }
 
+  void bad_srs_dimension(BuildingCtx* b, std::string_view sd) {
+    const std::string reason = "srsDimension=\"" + std::string(sd.substr(0, 40)) +
+                               "\" is not 2 or 3; ignored (the dimension is taken from the coordinates)";
+    if (b) {
+      b->defect("BAD_SRS_DIMENSION", reason);
+    } else if (!bad_dimension_said_) {
+      bad_dimension_said_ = true;
+      problems_.push_back(Problem{"", name_, "read", "BAD_SRS_DIMENSION", reason});
+    }
+  }
+
   void note_srs(const char* srs) {
     if (info_.srs_name.empty()) {
       info_.srs_name = srs;
@@ -641,6 +716,10 @@ class Reader {
     ctx->mesh.source_file = name_;
     if (id && *id) {
       ctx->mesh.source_id = id;
+      if (!building_ids_.insert(ctx->mesh.source_id).second)
+        ctx->defect("DUPLICATE_ID", "gml:id \"" + ctx->mesh.source_id +
+                                        "\" is used by an earlier building of the file too; both are kept (tell them "
+                                        "apart by fp_id in the footprints layer)");
     } else {
       ctx->mesh.source_id = std::string(is_part ? "BuildingPart" : "Building") + "#" +
                             std::to_string(info_.buildings + info_.building_parts) + "@line" +
@@ -777,9 +856,15 @@ class Reader {
     }
     if (m.faces.empty()) {
       if (ctx.has_parts) return;  // the parts carry the building
-      problems_.push_back(Problem{m.source_id, name_, "read", "NO_GEOMETRY",
-                                  std::string(ctx.is_part ? "BuildingPart" : "Building") +
-                                      " has no surface geometry (no polygon in any lod0-lod4 property)"});
+      std::string reason = std::string(ctx.is_part ? "BuildingPart" : "Building") +
+                           " has no surface geometry (no polygon in any lod0-lod4 property)";
+      if (!ctx.foreign_gml_ns.empty())
+        reason += "; its geometry elements are in the namespace \"" + ctx.foreign_gml_ns.substr(0, 120) +
+                  "\", not GML's (http://www.opengis.net/gml or http://www.opengis.net/gml/3.2)";
+      else if (!ctx.defects.empty())
+        reason += " left after the defects above";
+      problems_.push_back(Problem{m.source_id, name_, "read", "NO_GEOMETRY", reason});
+      ++info_.buildings_dropped;
       return;
     }
     // LoD choice: the highest the building has, or the one asked for. Faces without a LoD stay.
@@ -800,6 +885,7 @@ class Reader {
         problems_.push_back(Problem{m.source_id, name_, "read", "NO_GEOMETRY_AT_LOD",
                                     "no geometry at LoD " + std::to_string(want) + " (the building has LoD " + avail +
                                         ")"});
+        ++info_.buildings_dropped;
         return;
       }
       if (have != (1 << want)) filter_lod(m, static_cast<std::uint8_t>(want));
@@ -871,6 +957,13 @@ class Reader {
 
   void add_coordinates(BuildingCtx& b, const Frame& f) {
     coords_.clear();
+    if (text_overflow_) {
+      if (poly_ok_)
+        b.defect("BAD_COORDINATES", "polygon " + poly_label() + ": coordinate list longer than " +
+                                        std::to_string(opt_.max_coordinate_chars) + " characters; dropped");
+      poly_ok_ = false;
+      return;
+    }
     detail::CoordStatus st;
     int dim = 0;
     if (f.tag == Tag::Coordinates) {
@@ -902,6 +995,18 @@ class Reader {
       }
       poly_ok_ = false;
       return;
+    }
+    for (double v : coords_) {
+      if (std::fabs(v) > opt_.max_abs_coordinate) {
+        if (poly_ok_) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%.6g", v);
+          b.defect("COORDINATE_OUT_OF_RANGE", "polygon " + poly_label() + " has the coordinate " + buf +
+                                                  ", beyond any position on Earth in any CRS; dropped");
+        }
+        poly_ok_ = false;
+        return;
+      }
     }
     for (std::size_t k = 0; k + dim <= coords_.size(); k += static_cast<std::size_t>(dim))
       ring_.push_back(Point3{coords_[k], coords_[k + 1], dim == 3 ? coords_[k + 2] : 0.0});
@@ -971,7 +1076,10 @@ class Reader {
   Capture capture_ = Capture::None;
   std::size_t capture_depth_ = 0;
   std::string text_;
+  bool text_overflow_ = false;
   std::vector<double> coords_;
+  std::unordered_set<std::string> building_ids_;  // for DUPLICATE_ID
+  bool bad_dimension_said_ = false;
   int coord_dim_attr_ = 0;
   char cs_ = ',', ts_ = ' ', decimal_ = '.';
 

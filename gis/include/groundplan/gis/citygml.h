@@ -33,6 +33,12 @@ struct CityGmlOptions {
   /// Buildings whose xlink targets were not found yet are held back (forward references) up to this
   /// many; beyond that (and at the end of the file) they are delivered with XLINK_TARGET_MISSING.
   std::size_t max_pending_buildings = 256;
+  /// A coordinate list (posList, pos, coordinates) longer than this many characters drops its polygon
+  /// (BAD_COORDINATES): text is kept only up to this, whatever a count or srsDimension claims (issue 8).
+  std::size_t max_coordinate_chars = 64u << 20;
+  /// A polygon with a coordinate beyond this magnitude is dropped (COORDINATE_OUT_OF_RANGE): no CRS on
+  /// Earth has values past 1e9 (metres or degrees); such numbers would only break the later stages.
+  double max_abs_coordinate = 1e9;
 };
 
 /// What the reader learnt about one file.
@@ -49,6 +55,8 @@ struct SourceInfo {
   std::size_t buildings = 0;       // Building elements met
   std::size_t building_parts = 0;  // BuildingPart elements met
   std::size_t meshes = 0;          // meshes delivered to the callback
+  std::size_t buildings_dropped = 0;  // buildings (parts) given up, each with a Problem naming it (NO_GEOMETRY,
+                                      // NO_GEOMETRY_AT_LOD, TRUNCATED): meshes + buildings_dropped = all met
   std::size_t faces = 0;           // faces in those meshes
   std::size_t xlinks_resolved = 0;
   std::size_t xlinks_missing = 0;
@@ -63,11 +71,14 @@ using MeshCallback = std::function<void(Mesh&&)>;
 
 /// Reads `path` (any GDAL VSI path works too: /vsigzip/, /vsizip/, /vsimem/).
 /// Per-building defects (ring of < 3 points, NaN/Inf, unparseable numbers, missing xlink target,
-/// no geometry) are appended to `problems` (stage "read") and reading goes on. A file that is not
+/// no geometry) are appended to `problems` (stage "read") and reading goes on. A building that is given
+/// up (no mesh delivered) has a Problem NO_GEOMETRY, NO_GEOMETRY_AT_LOD or TRUNCATED; other codes name
+/// defects of buildings still delivered. A file that is not
 /// CityGML (no CityGML namespace) yields no meshes and one Problem NOT_CITYGML.
 /// Throws InputError naming the file when it cannot be opened or is not well-formed XML (truncated,
-/// garbage), or is hostile (entity declarations, nesting too deep); meshes delivered before the error
-/// stay delivered. Exceptions thrown by `on_mesh` propagate (e.g. Cancelled).
+/// garbage, empty), or is hostile (entity declarations, nesting too deep); meshes delivered before the
+/// error stay delivered, buildings complete but held back for a forward xlink are delivered before the
+/// throw, and buildings open at the error get a Problem TRUNCATED. Exceptions thrown by `on_mesh` propagate (e.g. Cancelled).
 void read_citygml(const std::string& path, const CityGmlOptions& options, const MeshCallback& on_mesh,
                   std::vector<Problem>& problems, SourceInfo& info);
 
