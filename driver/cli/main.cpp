@@ -167,6 +167,25 @@ std::size_t count_holes(const PipelineResult& r) {
   return holes;
 }
 
+/// --stats: counts (buildings = footprints + dropped: nothing lost) and per-stage timings. False (said
+/// on stderr) when the file cannot be written.
+bool write_stats(const std::string& path, const PipelineResult& result, double write_s, const nlohmann::json* verify) {
+  nlohmann::json j;
+  j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
+                 {"dropped", result.buildings_dropped},  {"ground_plans", result.plans.size()},
+                 {"holes", count_holes(result)},          {"problems", count_defects(result)}};
+  j["timings_s"] = {{"read", result.timings.read_s}, {"footprints", result.timings.footprints_s},
+                    {"union", result.timings.union_s}, {"write", write_s}};
+  if (verify) j["verify"] = *verify;
+  std::ofstream f(path);
+  f << j.dump(2) << '\n';
+  if (!f) {
+    std::fprintf(stderr, "groundplan: cannot write stats file %s\n", path.c_str());
+    return false;
+  }
+  return true;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{
       "groundplan: ground plans (the exact union of building footprints) from 3D city models.\n"
@@ -232,6 +251,18 @@ int run(int argc, char** argv) {
     });
   const PipelineResult result = groundplan::gis::run_pipeline(options, progress.sub(0, 1));
 
+  // Nothing usable (every building a problem, or no building at all): say so and fail, without
+  // writing an empty result that would look like success (issue 8). The problems say why.
+  if (result.footprints.empty()) {
+    if (!ogr.quiet) print_problems(result);
+    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
+                 result.buildings_read == 0
+                     ? "no building found"
+                     : (std::to_string(result.buildings_read) + " buildings read, none gave a footprint").c_str());
+    if (!stats_path.empty()) write_stats(stats_path, result, 0, nullptr);
+    return 1;
+  }
+
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
   const bool dbf = writes_dbf(ogr);
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
@@ -295,21 +326,7 @@ int run(int argc, char** argv) {
                    {"holes", c.holes_ours},       {"holes_geos", c.holes_geos},        {"invalid", c.invalid_ours}};
     if (!c.matches()) rc = 3;
   }
-  if (!stats_path.empty()) {
-    nlohmann::json j;
-    j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
-                   {"ground_plans", result.plans.size()}, {"holes", holes},
-                   {"problems", count_defects(result)}};
-    j["timings_s"] = {{"read", result.timings.read_s}, {"footprints", result.timings.footprints_s},
-                      {"union", result.timings.union_s}, {"write", write_s}};
-    if (verify) j["verify"] = verify_json;
-    std::ofstream f(stats_path);
-    f << j.dump(2) << '\n';
-    if (!f) {
-      std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());
-      return 1;
-    }
-  }
+  if (!stats_path.empty() && !write_stats(stats_path, result, write_s, verify ? &verify_json : nullptr)) return 1;
   return rc;
 }
 

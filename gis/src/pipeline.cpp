@@ -115,14 +115,25 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     read_options.target_srs = working_definition;  // KML/glTF are placed by the reader, in this CRS
     auto on_mesh = [&](Mesh&& mesh) {
       ++result.buildings_read;
-      if (!info.in_working_crs && !frame) {
-        CrsOptions crs;
-        crs.target_srs = working_definition;
-        frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
-      }
       std::string reason;
-      if (frame && !frame->transform(mesh, &reason)) {
+      bool placed = true;
+      try {
+        if (!info.in_working_crs && !frame) {
+          CrsOptions crs;
+          crs.target_srs = working_definition;
+          frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
+        }
+        placed = !frame || frame->transform(mesh, &reason);
+      } catch (const Error& e) {
+        // The file's CRS cannot hold this building (EPSG:4326 on metres ...): the file's fault, so the
+        // file stops here (the caller's catch); this building is named too, so that it is not lost.
+        result.problems.push_back({mesh.source_id, file, "georeference", "CRS_MISMATCH", e.what()});
+        ++result.buildings_dropped;
+        throw;
+      }
+      if (!placed) {
         result.problems.push_back({mesh.source_id, file, "georeference", "TRANSFORM_FAILED", reason});
+        ++result.buildings_dropped;
         return;
       }
       const auto t_fp = clock_type::now();
@@ -130,6 +141,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
       footprint_s += seconds_since(t_fp);
       if (!fp.ok) {
         result.problems.push_back({mesh.source_id, file, "footprint", fp.code, fp.reason});
+        ++result.buildings_dropped;
         return;
       }
       fp.footprint.source_file = file;
@@ -142,11 +154,21 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     } catch (const Cancelled&) {
       throw;
     } catch (const InputError& e) {
-      // One unreadable file does not stop the others; it is a problem of its own.
+      // One unreadable file does not stop the others; it is a problem of its own. Buildings read
+      // before the fault stay (a truncated file).
       ++files_failed;
       if (first_failure.empty()) first_failure = e.what();
       result.problems.push_back({"", file, "read", "UNREADABLE_FILE", e.what()});
+    } catch (const InvalidArgument& e) {
+      // The file's CRS cannot go to the working CRS (its srsName unknown while the first file, or
+      // -t_srs, fixed one): the same, a problem of this file. A bad -t_srs fails every file, so the run.
+      ++files_failed;
+      if (first_failure.empty()) first_failure = e.what();
+      result.problems.push_back({"", file, "georeference", "UNREADABLE_FILE", e.what()});
     }
+    // Buildings the reader gave up (each has its Problem) count as read: nothing is lost silently.
+    result.buildings_read += info.citygml.buildings_dropped;
+    result.buildings_dropped += info.citygml.buildings_dropped;
     if (info.in_working_crs) {
       for (const std::string& note : info.notes) result.problems.push_back({"", file, "georeference", "NOTE", note});
       if (result.crs_wkt.empty() && info.working_crs.known) {
@@ -165,7 +187,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
       }
     }
   }
-  if (files_failed == files.size()) throw InputError(first_failure);
+  if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
   result.timings.footprints_s = footprint_s;
   result.timings.read_s = seconds_since(t_read) - footprint_s;
 

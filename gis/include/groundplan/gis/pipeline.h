@@ -30,13 +30,17 @@ struct PipelineResult {
   std::vector<Footprint> footprints;  // one per building (part) with a usable footprint
   std::vector<GroundPlan> plans;      // members index `footprints`
   std::vector<Problem> problems;      // every building not in a plan, and notes
-  std::size_t buildings_read = 0;     // building meshes (Building or BuildingPart) read from the inputs
+  std::size_t buildings_read = 0;     // buildings (Building or BuildingPart) met in the inputs: a mesh each, or
+                                      // given up by the reader with a Problem (NO_GEOMETRY, TRUNCATED ...)
+  std::size_t buildings_dropped = 0;  // of those, the ones with no footprint, each named by a Problem (stage read,
+                                      // georeference or footprint): buildings_read = footprints + buildings_dropped
   std::string crs_wkt;                // working CRS (WKT2), empty when the input has no CRS
   std::string crs_name;               // e.g. "EPSG:25833", for messages
   StageTimings timings;
 };
 
-/// Runs read -> footprints -> union. Throws InputError when no input can be read at all, Cancelled
+/// Runs read -> footprints -> union. Throws InputError when no input can be read at all (every file
+/// unreadable and no footprint from any: a truncated file still gives the buildings before the cut), Cancelled
 /// when `progress` asks to stop. A bad building is a Problem, not an exception.
 PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
 
