@@ -267,6 +267,7 @@ class BlockEngine {
   // --- exact event order on a line
   int cmp(const Line& L, const Event& x, const Event& y) const;
   void scan(const Line& L, std::vector<Cand>& out);
+  void build_near_lists(const std::vector<Box>& boxes);
   Event event_of(const Line& L, const Cand& c, int which) const;
   void rays_at(const Line& L, const Event& x, const std::vector<Cand>& cands, std::vector<Ray>& out) const;
   // --- angular order around a point, relative to a reference direction
@@ -292,13 +293,17 @@ class BlockEngine {
   std::vector<Box> eboxes_, pboxes_;
   std::vector<Edge> edges_;
   std::vector<Poly> polys_;
-  BoxGrid edge_grid_, poly_grid_;
+  BoxGrid poly_grid_;
+  // Broad phase, once per block: for each edge, the edges whose closed boxes meet its box (CSR).
+  // Every scan runs along one whole input edge, so this list is all it needs.
+  std::vector<std::uint32_t> near_start_, near_items_, sweep_order_, sweep_active_;
   std::vector<Piece> pieces_;               // walked pieces, one list per edge (no per-edge allocation)
   std::vector<std::uint32_t> first_piece_;  // head of each edge's list, or kNone
   std::vector<Piece> chain_scratch_;
   std::vector<std::uint8_t> checked_;  // edges proven by the check of an exact twin
   std::vector<RingOut> rings_;
   std::vector<Cand> scratch_cands_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pair_scratch_;
   std::vector<Point2> load_ring_;
   mutable std::vector<std::pair<int, Ray>> sort_scratch_;
   std::vector<Ray> walk_rays_;
@@ -360,7 +365,7 @@ void BlockEngine::load() {
     }
   }
   if (edges_.empty()) return;
-  edge_grid_.build(eboxes, all, edges_.size() / 2 + 1);
+  build_near_lists(eboxes);
   poly_grid_.build(pboxes, all, polys_.size() + 1);
   first_piece_.assign(edges_.size(), kNone);
   checked_.assign(edges_.size(), 0);
@@ -388,18 +393,46 @@ int BlockEngine::cmp(const Line& L, const Event& x, const Event& y) const {
   return flip ? -r : r;
 }
 
+void BlockEngine::build_near_lists(const std::vector<Box>& boxes) {
+  const std::size_t n = boxes.size();
+  std::vector<std::uint32_t>& order = sweep_order_;
+  order.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return boxes[a].minx < boxes[b].minx; });
+  // pairs (a, b) with meeting boxes, found by a sweep over x; stored both ways
+  std::vector<std::uint32_t>& act = sweep_active_;
+  act.clear();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs = pair_scratch_;
+  pairs.clear();
+  for (std::uint32_t i : order) {
+    const Box& b = boxes[i];
+    std::size_t w = 0;
+    for (std::size_t r = 0; r < act.size(); ++r) {
+      const std::uint32_t j = act[r];
+      if (boxes[j].maxx < b.minx) continue;  // left behind for good
+      act[w++] = j;
+      if (boxes[j].miny <= b.maxy && b.miny <= boxes[j].maxy) {
+        pairs.emplace_back(i, j);
+        pairs.emplace_back(j, i);
+      }
+    }
+    act.resize(w);
+    act.push_back(i);
+  }
+  near_start_.assign(n + 1, 0);
+  for (const auto& p : pairs) ++near_start_[p.first + 1];
+  for (std::size_t k = 1; k <= n; ++k) near_start_[k] += near_start_[k - 1];
+  near_items_.resize(pairs.size());
+  std::vector<std::uint32_t>& fill = sweep_order_;  // reuse
+  fill.assign(near_start_.begin(), near_start_.end() - 1);
+  for (const auto& p : pairs) near_items_[fill[p.first]++] = p.second;
+}
+
 void BlockEngine::scan(const Line& L, std::vector<Cand>& out) {
   out.clear();
-  Box lb;
-  lb.add(L.a);
-  lb.add(L.b);
-  edge_grid_.query(lb, [&](std::uint32_t fi) {
-    if (fi == L.e) return;
+  for (std::uint32_t k = near_start_[L.e]; k < near_start_[L.e + 1]; ++k) {
+    const std::uint32_t fi = near_items_[k];
     const Edge& f = edges_[fi];
-    Box fb;
-    fb.add(f.p0);
-    fb.add(f.p1);
-    if (!fb.overlaps(lb)) return;
     const int o0 = orient(L.a, L.b, f.p0), o1 = orient(L.a, L.b, f.p1);
     if (o0 == 0 && o1 == 0) {
       // collinear: overlap of the extents along the line
@@ -420,7 +453,7 @@ void BlockEngine::scan(const Line& L, std::vector<Cand>& out) {
         out.push_back({fi, Cand::Crossing});
       }
     }
-  });
+  }
 }
 
 /// The event of candidate c (which = 0/1 selects a collinear edge's endpoint).
