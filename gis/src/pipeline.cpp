@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <unordered_set>
 
 namespace groundplan::gis {
 namespace {
@@ -113,8 +114,11 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     ReadInfo info;
     std::unique_ptr<WorkingFrame> frame;
     read_options.target_srs = working_definition;  // KML/glTF are placed by the reader, in this CRS
+    std::unordered_set<std::string> delivered;  // ids of this file's meshes (for the given-up count below)
+    const std::size_t first_problem = result.problems.size();
     auto on_mesh = [&](Mesh&& mesh) {
       ++result.buildings_read;
+      delivered.insert(mesh.source_id);
       std::string reason;
       bool placed = true;
       try {
@@ -166,9 +170,17 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
       if (first_failure.empty()) first_failure = e.what();
       result.problems.push_back({"", file, "georeference", "UNREADABLE_FILE", e.what()});
     }
-    // Buildings the reader gave up (each has its Problem) count as read: nothing is lost silently.
-    result.buildings_read += info.citygml.buildings_dropped;
-    result.buildings_dropped += info.citygml.buildings_dropped;
+    // Buildings the reader gave up count as read and dropped: nothing is lost silently. Whatever the
+    // format, such a building is named by a read-stage Problem and gave no mesh (a building that did
+    // give one may have read-stage defects too: a dropped face, a missing xlink).
+    std::unordered_set<std::string> given_up;
+    for (std::size_t k = first_problem; k < result.problems.size(); ++k) {
+      const Problem& p = result.problems[k];
+      if (p.stage == "read" && !p.source_id.empty() && p.code != "NOTE" && !delivered.count(p.source_id))
+        given_up.insert(p.source_id);
+    }
+    result.buildings_read += given_up.size();
+    result.buildings_dropped += given_up.size();
     if (info.in_working_crs) {
       for (const std::string& note : info.notes) result.problems.push_back({"", file, "georeference", "NOTE", note});
       if (result.crs_wkt.empty() && info.working_crs.known) {
