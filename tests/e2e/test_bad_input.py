@@ -1,0 +1,115 @@
+# SPDX-License-Identifier: MIT
+"""Bad and hostile input (issue 8): every file of tests/corpus/bad through the real CLI with --stats.
+Each file holds one defect; tests/corpus/bad/expected.json says what must come out: the exit code, the
+problem codes, a fragment of the message, and the counts. Whatever the file, the run must end in
+bounded time, never crash, name the file (and the building, when there is one) in its message, never
+read outside its input, and lose no building silently."""
+import json
+import os
+import pathlib
+
+import pytest
+from osgeo import ogr
+
+from conftest import BIN, SOURCE_DIR, run
+
+CORPUS = SOURCE_DIR / "tests" / "corpus" / "bad"
+EXPECTED = json.loads((CORPUS / "expected.json").read_text())
+INPUT_SUFFIXES = {".gml", ".xml", ".citygml", ".kml", ".kmz", ".gltf", ".glb"}  # a .dae belongs to a .kml
+
+
+def _passwd_markers():
+    """Lines of /etc/passwd that must never show up anywhere (XXE must not read it)."""
+    try:
+        lines = pathlib.Path("/etc/passwd").read_text().splitlines()
+    except OSError:
+        return []
+    return [l for l in lines if l.count(":") >= 6][:3]
+
+
+PASSWD = _passwd_markers()
+
+
+def _problems(path):
+    ds = ogr.Open(str(path))
+    return [f.items() for f in ds.GetLayerByName("problems")]
+
+
+def dropped_buildings(problems, footprints):
+    """Buildings without a footprint, each named by a problem: one per georeference/footprint-stage
+    problem, and one per building id (per file) that only read-stage problems name: a building given up
+    by its reader. Read-stage defects of a building that still has a footprint do not count."""
+    later = [p for p in problems if p["source_id"] and p["stage"] in ("georeference", "footprint")]
+    kept = {(f["source_file"], f["source_id"]) for f in footprints} | {(p["file"], p["source_id"]) for p in later}
+    given_up = {(p["file"], p["source_id"]) for p in problems if p["source_id"] and p["stage"] == "read"
+                and p["code"] != "NOTE" and (p["file"], p["source_id"]) not in kept}
+    return len(later) + len(given_up)
+
+
+def check_nothing_lost(gpkg, counts):
+    """buildings in = footprints + buildings given up (each with a problem naming it); every footprint
+    is a member of a plan or has a union-stage problem. Returns the problems."""
+    ds = ogr.Open(str(gpkg))
+    problems = [f.items() for f in ds.GetLayerByName("problems")]
+    footprints = [f.items() for f in ds.GetLayerByName("footprints")]
+    assert len(footprints) == counts["footprints"]
+    dropped = dropped_buildings(problems, footprints)
+    assert counts["buildings"] == counts["footprints"] + dropped, (counts, problems)
+    assert counts["dropped"] == dropped
+    union_problems = {p["source_id"] for p in problems if p["stage"] == "union"}
+    members = {(m["gp_id"], m["fp_id"]) for m in (f.items() for f in ds.GetLayerByName("plan_members"))}
+    member_fps = {fp for _, fp in members}
+    for f in footprints:
+        in_plan = f["gp_id"] is not None and f["fp_id"] in member_fps
+        assert in_plan or f["source_id"] in union_problems, f["source_id"]
+    return problems
+
+
+def test_every_corpus_file_has_an_expectation():
+    files = {p.name for p in CORPUS.iterdir() if p.suffix.lower() in INPUT_SUFFIXES}
+    assert files == set(EXPECTED), (files ^ set(EXPECTED))
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_bad_file(tmp_path, name):
+    want = EXPECTED[name]
+    src = CORPUS / name
+    out, stats = tmp_path / "out.gpkg", tmp_path / "stats.json"
+    p = run([BIN, "--stats", stats, "-f", "GPKG", out, src, "ground_plans", "footprints", "problems",
+             "plan_members"], check=False)
+    assert p.returncode >= 0, f"killed by signal {-p.returncode}\n{p.stderr}"
+    assert p.returncode == want["exit"], f"exit {p.returncode}\nstdout:\n{p.stdout}\nstderr:\n{p.stderr}"
+    assert "Traceback" not in p.stderr and "terminate called" not in p.stderr
+    # Every message names the file and says what is wrong.
+    assert src.name in p.stderr, p.stderr
+    assert want["message"] in p.stderr, p.stderr
+    for b in want.get("building_ids", []):
+        assert f"building {b}:" in p.stderr, p.stderr
+    texts = [p.stdout, p.stderr]
+    if want["exit"] == 0:
+        counts = json.loads(stats.read_text())["counts"]
+        for key in ("buildings", "footprints", "dropped"):
+            assert counts[key] == want[key], (key, counts)
+        problems = check_nothing_lost(out, counts)
+        codes = {pr["code"] for pr in problems}
+        assert set(want["codes"]) <= codes, codes
+        for pr in problems:  # the file itself, or a model it links (a KML's .dae)
+            assert pr["file"] == str(src) or pathlib.Path(pr["file"]).resolve().is_relative_to(CORPUS), pr
+            texts.append(pr["reason"])
+        texts.append(out.read_bytes().decode("latin-1"))
+    else:
+        assert not out.exists() or want.get("output_written", False)
+    for t in texts:
+        for line in PASSWD:
+            assert line not in t, "content of /etc/passwd in the output"
+
+
+def test_whole_corpus_folder_as_one_input(tmp_path):
+    """A folder of tiles where many are bad: the good buildings still come out, nothing is lost."""
+    out, stats = tmp_path / "out.gpkg", tmp_path / "stats.json"
+    p = run([BIN, "--stats", stats, "-f", "GPKG", out, CORPUS, "ground_plans", "footprints", "problems",
+             "plan_members"], check=False)
+    assert p.returncode == 0, p.stderr
+    counts = json.loads(stats.read_text())["counts"]
+    assert counts["footprints"] >= sum(1 for w in EXPECTED.values() if w["exit"] == 0)
+    check_nothing_lost(out, counts)
