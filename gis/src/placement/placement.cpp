@@ -76,8 +76,22 @@ Georeferencer::~Georeferencer() = default;
 Georeferencer::Georeferencer(Georeferencer&&) noexcept = default;
 Georeferencer& Georeferencer::operator=(Georeferencer&&) noexcept = default;
 
+void Georeferencer::decide(double lat, double lon) {
+  if (!frame_.decided()) {
+    frame_.decide(lat, lon);  // the UTM zone of the anchor, not of a vertex
+    // WorkingFrame speaks of a source CRS; here the "source" is the models' WGS 84 anchors.
+    notes_.clear();
+    for (std::string n : frame_.notes()) {
+      const std::string from = "source CRS " + std::string(kGeodetic) + " is not projected in metres", centre = "the data's centre";
+      if (n.rfind(from, 0) == 0) n = "models are georeferenced in WGS 84 longitude/latitude" + n.substr(from.size());
+      if (const auto at = n.find(centre); at != std::string::npos) n.replace(at, centre.size(), "the first model's anchor");
+      notes_.push_back(std::move(n));
+    }
+  }
+}
+
 bool Georeferencer::geodetic_to_working(Mesh& mesh, double lat, double lon, std::string* reason) {
-  if (!frame_.decided()) frame_.decide(lat, lon);  // the UTM zone of the anchor, not of a vertex
+  decide(lat, lon);
   return frame_.transform(mesh, reason);
 }
 
@@ -115,7 +129,7 @@ bool Georeferencer::place_ecef(Mesh& mesh, std::string* reason) {
 }
 
 bool Georeferencer::anchor_in_working(double lon_deg, double lat_deg, double& e, double& n) {
-  if (!frame_.decided()) frame_.decide(lat_deg, lon_deg);
+  decide(lat_deg, lon_deg);
   double x = lat_deg, y = lon_deg;
   if (!frame_.transform_point(x, y)) return false;
   e = x;
@@ -125,6 +139,6 @@ bool Georeferencer::anchor_in_working(double lon_deg, double lat_deg, double& e,
 
 const WorkingCrs& Georeferencer::working_crs() const { return frame_.working_crs(); }
 bool Georeferencer::decided() const { return frame_.decided(); }
-const std::vector<std::string>& Georeferencer::notes() const { return frame_.notes(); }
+const std::vector<std::string>& Georeferencer::notes() const { return notes_; }
 
 }  // namespace groundplan::gis

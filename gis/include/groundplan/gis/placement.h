@@ -65,8 +65,10 @@ class Georeferencer {
   bool anchor_in_working(double lon_deg, double lat_deg, double& e, double& n);
 
  private:
+  void decide(double lat_deg, double lon_deg);
   bool geodetic_to_working(Mesh& mesh, double lat_decide, double lon_decide, std::string* reason);
   WorkingFrame frame_;
+  std::vector<std::string> notes_;
 };
 
 }  // namespace groundplan::gis
