@@ -113,3 +113,36 @@ def test_whole_corpus_folder_as_one_input(tmp_path):
     counts = json.loads(stats.read_text())["counts"]
     assert counts["footprints"] >= sum(1 for w in EXPECTED.values() if w["exit"] == 0)
     check_nothing_lost(out, counts)
+
+
+def _real_inputs():
+    """Every real sample: sample_data/*/*.gml, every CityGML file of the shared data, and each shared
+    data folder of CityGML as one input (a folder of tiles)."""
+    from conftest import SAMPLES, SHARED_DATA
+    files = sorted(SAMPLES.glob("*/*.gml"))
+    folders = []
+    if SHARED_DATA.is_dir():
+        for d in sorted(p for p in SHARED_DATA.iterdir() if p.is_dir()):
+            gml = sorted(p for p in d.iterdir() if p.suffix.lower() in (".gml", ".citygml", ".xml"))
+            files += gml
+            if len(gml) > 1:
+                folders.append(d)
+    return files + folders
+
+
+@pytest.mark.parametrize("src", _real_inputs(), ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_nothing_lost_on_real_data(tmp_path, src):
+    """buildings in = footprints + buildings given up (each named by a problem), and every footprint is
+    a member of a plan or has a union-stage problem: via --stats and the output layers."""
+    out, stats = tmp_path / "out.gpkg", tmp_path / "stats.json"
+    p = run([BIN, "--stats", stats, "-f", "GPKG", out, src, "ground_plans", "footprints", "problems",
+             "plan_members"], check=False)
+    assert p.returncode >= 0, p.stderr
+    if p.returncode != 0:
+        # Only a file with nothing usable may fail, and it must say so.
+        assert "nothing usable" in p.stderr or "UNREADABLE" in p.stderr or src.name in p.stderr, p.stderr
+        counts = json.loads(stats.read_text())["counts"] if stats.exists() else None
+        assert counts is None or counts["footprints"] == 0
+        return
+    counts = json.loads(stats.read_text())["counts"]
+    check_nothing_lost(out, counts)
