@@ -146,3 +146,23 @@ def test_nothing_lost_on_real_data(tmp_path, src):
         return
     counts = json.loads(stats.read_text())["counts"]
     check_nothing_lost(out, counts)
+
+
+def test_python_progress_callback_returning_false_stops_the_translation():
+    """gdal.VectorTranslate with a callback that returns 0: GDAL stops with an error, nothing is left
+    half-written in silence. (The pipeline itself runs inside the driver's Open, which GDAL 3.6 gives no
+    progress callback: there the callback can only stop the writing; pipeline_test's
+    CancelStopsTheWork covers cancelling the pipeline through the library's Progress.)"""
+    from osgeo import gdal
+    from conftest import PLATEAU
+    calls = []
+
+    def stop(complete, message, data):
+        calls.append(complete)
+        return 0
+
+    out = "/vsimem/cancelled.gpkg"
+    with pytest.raises(RuntimeError):  # GDAL 3.6 reports the stop (or what it left behind) as an error
+        gdal.VectorTranslate(out, f"GROUNDPLAN:{PLATEAU}", format="GPKG", layers=["ground_plans"], callback=stop)
+    assert len(calls) == 1  # asked once, stopped at once
+    gdal.Unlink(out)
