@@ -73,7 +73,7 @@ int sampling_disagreements(const std::vector<Footprint>& fps, const std::vector<
   return bad;
 }
 
-constexpr int kCasesPerFamily = 600;
+constexpr int kCasesPerFamily = 1000;
 
 TEST_P(UnionProperty, MatchesGeos) {
   const Family fam = GetParam();

@@ -5,6 +5,7 @@
 #include <groundplan/error.h>
 #include <groundplan/raster_backend.h>
 
+#include "union_generators.h"
 #include "union_test_util.h"
 
 namespace groundplan {
@@ -161,6 +162,24 @@ TEST(UnionEngine, MembersListContributingFootprints) {
   ASSERT_EQ(plans.size(), 1u);
   EXPECT_EQ(plans[0].members, (std::vector<std::uint32_t>{0, 1, 2, 3}));
   EXPECT_NEAR(plans[0].area_m2, 210.0, 1e-9);
+}
+
+TEST(UnionEngine, ParallelOverBlocksIsDeterministicAndMatchesGeos) {
+  const auto city = testing::synthetic_city(2000, 7);
+  UnionParams one, two;
+  one.threads = 1;
+  two.threads = 2;
+  std::vector<Problem> p1, p2;
+  const auto a = build_ground_plans(city, one, p1);
+  const auto b = build_ground_plans(city, two, p2);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].polygon.outer, b[i].polygon.outer) << i;
+    EXPECT_EQ(a[i].members, b[i].members) << i;
+  }
+  EXPECT_TRUE(p1.empty());
+  const auto c = gis::compare_with_geos(city, b);
+  EXPECT_TRUE(c.matches(1e-9)) << c.summary();
 }
 
 TEST(UnionEngine, CudaDeviceThrowsWithoutCuda) {
