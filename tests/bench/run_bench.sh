@@ -3,6 +3,7 @@
 #   tests/bench/run_bench.sh BUILD_DIR [SIZES] [GEOS_MAX]
 # SIZES defaults to "1000 6000 60000 1000000"; GEOS is not run above GEOS_MAX footprints
 # (default 60000; its time grows faster than linearly: see RESULTS.md for the extrapolation).
+# Example (RESULTS.md): tests/bench/run_bench.sh build "1000 6000 60000 200000 1000000" 200000
 set -eu
 build=${1:-build}
 sizes=${2:-"1000 6000 60000 1000000"}
@@ -15,7 +16,7 @@ for n in $sizes; do
   "$bin" --n "$n" --engine ours --runs "$r"
   "$bin" --n "$n" --engine ours --runs "$r" --threads 1 | sed 's/^ours/ours_1thread/'
   if [ "$n" -le "$geos_max" ]; then
-    g=$([ "$n" -ge 60000 ] && echo 3 || echo 5)
+    g=$([ "$n" -ge 200000 ] && echo 1 || { [ "$n" -ge 60000 ] && echo 3 || echo 5; })
     "$bin" --n "$n" --engine geos --runs "$g"
     "$bin" --n "$n" --engine ours --runs "$r" --coverage | sed 's/^ours/ours_coverage_input/'
     "$bin" --n "$n" --engine coverage --runs "$g" --coverage

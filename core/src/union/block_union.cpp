@@ -370,7 +370,9 @@ void BlockEngine::load() {
   first_piece_.assign(edges_.size(), kNone);
   checked_.assign(edges_.size(), 0);
   pieces_.reserve(edges_.size() + 16);
-  step_limit_ = 16 * edges_.size() + 1024;
+  // A safety net against a walk that never closes (a bug), not a limit on real input: a ring has
+  // at most one step per piece of the block's arrangement, O(E^2) in the worst case.
+  step_limit_ = std::min<std::size_t>(edges_.size() * edges_.size() * 4 + 4096, std::size_t{1} << 40);
 }
 
 // ------------------------------------------------------------------------------------------------
