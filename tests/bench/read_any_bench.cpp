@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
   }
   std::sort(seconds.begin(), seconds.end());
   const double median = seconds[seconds.size() / 2];
-  std::printf("extent %.3f %.3f %.3f .. %.3f %.3f %.3f (size %.3f x %.3f x %.3f)\n", lo[0], lo[1], lo[2], hi[0], hi[1],
+  if (meshes)
+    std::printf("extent %.3f %.3f %.3f .. %.3f %.3f %.3f (size %.3f x %.3f x %.3f)\n", lo[0], lo[1], lo[2], hi[0], hi[1],
               hi[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
   std::printf("file %s\nsize_mb %.3f\nmeshes %zu\nfaces %zu\nruns %d\nmedian_s %.4f\nmin_s %.4f\nmb_per_s %.1f\n",
               path.c_str(), mb, meshes, faces, runs, median, seconds.front(), mb / median);
