@@ -112,7 +112,7 @@ GROUNDPLAN_FUZZ_TARGET(union) {
     if (p.stage == "union") union_problem.insert(p.source_id);
   for (std::size_t i = 0; i < fps.size(); ++i)
     if (!member[i] && !union_problem.count(fps[i].source_id))
-      groundplan_fuzz_fail("union", "a footprint is in no plan and has no union problem");
+      groundplan_fuzz_fail("union", ("footprint " + fps[i].source_id + " is in no plan and has no union problem").c_str());
 
   const gis::GeosComparison c = gis::compare_with_geos(fps, plans);
   if (c.invalid_ours) groundplan_fuzz_fail("union", ("invalid plan: " + c.first_invalid_reason).c_str());

@@ -48,9 +48,10 @@ for t in citygml srs_name coordinates union read_any; do
     -artifact_prefix="$work/$t/" "$work/$t/corpus" "$work/$t/seeds" > "$log" 2>&1
   rc=$?
   set -e
-  done_line=$(grep -E '^#[0-9]+ +DONE' "$log" | tail -1)
-  execs=$(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}')
-  echo "fuzz_$t: rc=$rc execs=${execs:-?} ${done_line:-$(tail -1 "$log")}"
+  last=$(grep -E '^#[0-9]+' "$log" | tail -1 || true)        # "#N ... cov: C ft: F corp: K/S ..."
+  execs=$(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}' || true)
+  rate=$(grep -E '^stat::average_exec_per_sec' "$log" | awk '{print $2}' || true)
+  echo "fuzz_$t: rc=$rc ${seconds}s execs=${execs:-?} exec/s=${rate:-?} | ${last:-$(tail -1 "$log")}"
   if [ $rc -ne 0 ]; then
     status=1
     grep -E 'ERROR|SUMMARY|groundplan fuzz' "$log" | head -5
