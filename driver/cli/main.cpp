@@ -198,7 +198,7 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", std::string("groundplan ") + GROUNDPLAN_VERSION + " (GDAL " +
                                         GDALVersionInfo("RELEASE_NAME") + ")");
   double resolution = 0;
-  std::string device = "auto", footprints = "auto", stats_path, preview_path;
+  std::string device = "auto", footprints = "auto", stats_path, preview_path, origin;
   int lod = -1;
   bool verify = false;
   app.add_option("--resolution", resolution, "Raster pixel in metres for blocks and seeds (0 = automatic); exact "
@@ -206,6 +206,7 @@ int run(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--device", device, "auto|cpu|cuda: where blocks are rasterised");
   app.add_option("--footprints", footprints, "auto|ground-surface|decompose: where footprints come from");
+  app.add_option("--origin", origin, "lon,lat[,alt] where a glTF without georeference or a bare .dae sits");
   app.add_option("--lod", lod, "Level of detail to read (-1 = highest per building)")->check(CLI::Range(-1, 4));
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
@@ -241,6 +242,7 @@ int run(int argc, char** argv) {
   options.union_params.device = groundplan::gis::device_from_string(device);
   options.footprints = groundplan::gis::footprint_mode_from_string(footprints);
   options.lod = lod;
+  options.origin = origin;
 
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();

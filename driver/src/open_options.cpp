@@ -25,6 +25,8 @@ const char* open_option_list_xml() {
          "building)' default='-1'/>"
          "  <Option name='T_SRS' type='string' description='Working CRS for the union (projected, metric); default: "
          "the source CRS when projected, else the UTM zone of the data'/>"
+         "  <Option name='ORIGIN' type='string' description='lon,lat[,alt] (degrees, metres) where a glTF without "
+         "georeference or a bare COLLADA file sits'/>"
          "</OpenOptionList>";
 }
 
@@ -68,6 +70,7 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
     o.lod = static_cast<int>(lod);
   }
   if (const char* v = CSLFetchNameValue(open_options, "T_SRS")) o.t_srs = v;
+  if (const char* v = CSLFetchNameValue(open_options, "ORIGIN")) o.origin = v;
   return o;
 }
 

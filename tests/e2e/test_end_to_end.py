@@ -6,7 +6,7 @@ import json
 import pytest
 from osgeo import gdal, ogr
 
-from conftest import BERLIN, BIN, LORUP, PLATEAU, PLATEAU_SMALL, TUM, layer_rows, run
+from conftest import BERLIN, BIN, LORUP, PLATEAU, PLATEAU_SMALL, SHARED_DATA, TUM, layer_rows, run
 
 SAMPLES = [PLATEAU_SMALL, PLATEAU, LORUP, TUM, BERLIN]
 
@@ -15,7 +15,7 @@ def test_plugin_is_listed_with_its_open_options():
     formats = run(["ogrinfo", "--formats"]).stdout
     assert "GroundPlan" in formats
     doc = run(["ogrinfo", "--format", "GroundPlan"]).stdout
-    for option in ("RESOLUTION", "DEVICE", "FOOTPRINTS", "LOD", "T_SRS"):
+    for option in ("RESOLUTION", "DEVICE", "FOOTPRINTS", "LOD", "T_SRS", "ORIGIN"):
         assert option in doc
     assert "GROUNDPLAN:" in doc  # the connection prefix
 
@@ -135,3 +135,19 @@ def test_shapefile_output(tmp_path):
     assert lyr.GetSpatialRef() is not None
     for f in lyr:
         assert f.GetGeometryRef().IsValid()
+
+
+def test_kmz_models_through_both_routes(tmp_path):
+    """Google's shared-textures KMZ: two COLLADA models placed at one Location in San Francisco."""
+    kmz = SHARED_DATA / "kml-collada-macky-google" / "shared-textures.kmz"
+    a, b = tmp_path / "cli.gpkg", tmp_path / "ogr2ogr.gpkg"
+    run([BIN, "--verify", "-f", "GPKG", a, kmz, "ground_plans", "footprints"])
+    run(["ogr2ogr", "-f", "GPKG", b, f"GROUNDPLAN:{kmz}", "ground_plans"])
+    assert layer_rows(a, "ground_plans") == layer_rows(b, "ground_plans")
+    ds = ogr.Open(str(a))
+    lyr = ds.GetLayerByName("ground_plans")
+    assert lyr.GetSpatialRef().GetAuthorityCode(None) == "32610"  # UTM 10N: San Francisco
+    assert ds.GetLayerByName("footprints").GetFeatureCount() == 2
+    minx, maxx, miny, maxy = lyr.GetExtent()
+    # The anchor, lon -122.451703589982 lat 37.80564180933, is at E 548,265.92 N 4,184,392.50 in UTM 10N (cs2cs).
+    assert minx < 548266 + 200 and maxx > 548266 - 200 and miny < 4184392 + 200 and maxy > 4184392 - 200
