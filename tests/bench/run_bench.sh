@@ -10,7 +10,7 @@ sizes=${2:-"1000 6000 60000 1000000"}
 geos_max=${3:-60000}
 bin="$build/bin/bench_union"
 runs_for() { if [ "$1" -ge 1000000 ]; then echo 3; elif [ "$1" -ge 60000 ]; then echo 5; else echo 7; fi; }
-echo "engine n runs median_wall_s min_wall_s max_wall_s median_cpu_s plans peak_rss_mib input_rss_mib"
+echo "engine n runs median_wall_s min_wall_s max_wall_s median_cpu_s plans peak_rss_mib input_rss_mib min_cpu_s"
 for n in $sizes; do
   r=$(runs_for "$n")
   "$bin" --n "$n" --engine ours --runs "$r"

@@ -26,59 +26,20 @@ using testing::Family;
 // seed 13000576 its union is 42 m2 off the even-odd union of the input, see
 // UnionRegression.NearCollinearGeosSnapsWrongly). So that family asserts validity, and either
 // GEOS's area, or agreement with an independent oracle: the exact even-odd membership of random
-// points (robust predicates), which does not depend on GEOS. Counts there are reported only.
+// points, which does not depend on GEOS. Counts there are reported only. In every family, when
+// counts, areas and validity agree but GEOS's SymDifference does not (it can fail on near-coincident
+// rounded vertices: UnionRegression.GeosSymDifferenceImplausibleSeed6000910), point sampling
+// decides; the summary line counts how often.
 class UnionProperty : public ::testing::TestWithParam<Family> {};
 
-/// Exact membership of p in the even-odd region of one polygon (perturbed ray to +x).
-bool inside_even_odd(const Polygon& poly, const Point2& p) {
-  bool odd = false;
-  auto ring = [&](const Ring& r) {
-    for (std::size_t i = 0, n = r.size(); i < n; ++i) {
-      const Point2& a = r[i];
-      const Point2& b = r[(i + 1) % n];
-      const bool up = a.y < b.y;
-      const Point2& lo = up ? a : b;
-      const Point2& hi = up ? b : a;
-      if (lo.y <= p.y && p.y < hi.y && robust::orient(lo, hi, p) > 0) odd = !odd;
-    }
-  };
-  ring(poly.outer);
-  for (const Ring& h : poly.holes) ring(h);
-  return odd;
-}
-
-/// Random points where membership in the plans and in the union of the footprints differ.
-int sampling_disagreements(const std::vector<Footprint>& fps, const std::vector<GroundPlan>& plans, int n,
-                           std::uint64_t seed) {
-  double minx = INFINITY, miny = INFINITY, maxx = -INFINITY, maxy = -INFINITY;
-  for (const Footprint& f : fps)
-    for (const Polygon& p : f.polygons)
-      for (const Point2& q : p.outer) {
-        minx = std::min(minx, q.x);
-        miny = std::min(miny, q.y);
-        maxx = std::max(maxx, q.x);
-        maxy = std::max(maxy, q.y);
-      }
-  testing::Rng rng(seed);
-  std::uniform_real_distribution<double> ux(minx, maxx), uy(miny, maxy);
-  int bad = 0;
-  for (int i = 0; i < n; ++i) {
-    const Point2 p{ux(rng), uy(rng)};
-    bool in_union = false, in_plans = false;
-    for (const Footprint& f : fps)
-      for (const Polygon& poly : f.polygons) in_union = in_union || inside_even_odd(poly, p);
-    for (const GroundPlan& g : plans) in_plans = in_plans || inside_even_odd(g.polygon, p);
-    bad += in_union != in_plans;
-  }
-  return bad;
-}
+using testing::sampling_disagreements;
 
 constexpr int kCasesPerFamily = 1000;
 
 TEST_P(UnionProperty, MatchesGeos) {
   const Family fam = GetParam();
   const auto oracle = fam == Family::NearCollinear ? testing::Oracle::AreaAndValid : testing::Oracle::Strict;
-  int failures = 0, count_mismatch = 0, geos_inconsistent = 0;
+  int failures = 0, count_mismatch = 0, geos_inconsistent = 0, symdiff_fallback = 0;
   for (int i = 0; i < kCasesPerFamily && failures < 3; ++i) {
     const std::uint64_t seed = 1000003ull * (static_cast<std::uint64_t>(fam) + 1) + static_cast<std::uint64_t>(i);
     testing::Rng rng(seed);
@@ -86,6 +47,7 @@ TEST_P(UnionProperty, MatchesGeos) {
     auto c = testing::run_and_compare(fps, 1, 1e-9, oracle);
     count_mismatch += !c.counts_match;
     geos_inconsistent += c.geos_self_inconsistent;
+    symdiff_fallback += c.geos_symdiff_implausible;
     if (!c.ok && oracle == testing::Oracle::AreaAndValid && c.cmp.invalid_ours == 0) {
       const int bad = sampling_disagreements(fps, c.plans, 4000, seed);
       c.ok = bad == 0;
@@ -98,7 +60,8 @@ TEST_P(UnionProperty, MatchesGeos) {
   }
   RecordProperty("count_mismatches", count_mismatch);
   std::cout << "[ " << testing::family_name(fam) << " ] " << kCasesPerFamily << " cases, polygon/hole count differs from GEOS in "
-            << count_mismatch << ", GEOS not a fixed point of its own union in " << geos_inconsistent << "\n";
+            << count_mismatch << ", GEOS not a fixed point of its own union in " << geos_inconsistent
+            << ", GEOS symmetric difference implausible (decided by sampling) in " << symdiff_fallback << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Families, UnionProperty, ::testing::ValuesIn(testing::kAllFamilies),

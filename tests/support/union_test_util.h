@@ -4,6 +4,7 @@
 #include <groundplan/gis/geos_reference.h>
 #include <groundplan/ground_plans.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ struct UnionCheck {
   gis::GeosComparison cmp;
   bool ok = false;
   bool geos_self_inconsistent = false;  // GEOS's union of its own result differed: that was used
+  bool geos_symdiff_implausible = false;  // counts, areas, validity agree but GEOS's symmetric difference
+                                          // did not: decided by sampling instead
   bool counts_match = false;
   std::string message;  // summary + input WKT when not ok
 };
@@ -35,6 +38,12 @@ enum class Oracle {
 /// a fixed point of GEOS's own union (it returned polygons sharing edges), that union is the reference.
 UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads = 1, double rel_tol = 1e-9,
                            Oracle oracle = Oracle::Strict);
+
+/// Random points (seeded) where membership in the plans and in the union of the footprints (each
+/// polygon by the even-odd rule) differ: an oracle independent of GEOS. Orientation in long double
+/// on random points (a point exactly on a boundary has probability zero).
+int sampling_disagreements(const std::vector<Footprint>& fps, const std::vector<GroundPlan>& plans, int n,
+                           std::uint64_t seed);
 
 /// WKT of all footprints (a MULTIPOLYGON-ish list, one per line) for failure messages.
 std::string describe(const std::vector<Footprint>& fps);

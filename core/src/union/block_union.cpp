@@ -300,7 +300,8 @@ class BlockEngine {
   std::vector<Piece> pieces_;               // walked pieces, one list per edge (no per-edge allocation)
   std::vector<std::uint32_t> first_piece_;  // head of each edge's list, or kNone
   std::vector<Piece> chain_scratch_;
-  std::vector<std::uint8_t> checked_;  // edges proven by the check of an exact twin
+  std::vector<std::uint8_t> checked_;
+  std::vector<std::uint32_t> check_order_;  // edges proven by the check of an exact twin
   std::vector<RingOut> rings_;
   std::vector<Cand> scratch_cands_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pair_scratch_;
@@ -609,13 +610,18 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
   std::vector<Ray>& rays = walk_rays_;
   std::vector<robust::Segment>& segs = walk_segs_;
   std::vector<std::uint32_t>& seg_edges = walk_seg_edges_;
+  std::uint32_t scanned_edge = kNone;
+  Point2 scanned_from;
   for (std::size_t step = 0;; ++step) {
     if (step > step_limit_) {
       const Point2 p = point_of(L, cur);
       throw TopologyError("boundary walk did not close (groundplan bug; please report with the input)", p.x, p.y);
     }
     ++stats_.walk_steps;
-    scan(L, cands);
+    // continuing straight along the same edge (a T-junction on an outer wall): same candidates
+    if (!(step > 0 && L.e == scanned_edge && L.a == scanned_from)) scan(L, cands);
+    scanned_edge = L.e;
+    scanned_from = L.a;
     // Lemma 1: the nearest event after cur.
     Event best_v{false, L.b, 0};  // the edge's own end is always an event
     segs.clear();
@@ -753,13 +759,15 @@ void BlockEngine::check_edge(std::uint32_t e) {
       if (cmp(L, ev, A) > 0 && cmp(L, ev, B) < 0) evs.push_back(ev);
     }
   }
-  // An exact twin (same segment, another polygon or ring: party walls) has exactly these pieces,
-  // and every boundary piece found below is walked for all edges of its collinear group, so the
-  // twin needs no check of its own.
+  // A collinear edge lying within this segment (an exact twin, or a shorter party wall along a
+  // longer one) has a subset of these pieces: every edge meeting it meets this segment. When this
+  // check ends, every boundary piece of the segment has been walked, and a walk records its pieces
+  // on every edge of the collinear group it walks along, that edge included. So it needs no check
+  // of its own.
   for (const Cand& c : cands) {
     if (c.kind != Cand::Collinear) continue;
     const Edge& f = edges_[c.edge];
-    if ((f.p0 == E.p0 && f.p1 == E.p1) || (f.p0 == E.p1 && f.p1 == E.p0)) checked_[c.edge] = 1;
+    if (L.within(f.p0) && L.within(f.p1)) checked_[c.edge] = 1;
   }
   std::sort(evs.begin(), evs.end(), [&](const Event& x, const Event& y) { return cmp(L, x, y) < 0; });
   evs.erase(std::unique(evs.begin(), evs.end(), [&](const Event& x, const Event& y) { return cmp(L, x, y) == 0; }),
@@ -1298,7 +1306,20 @@ BlockResult BlockEngine::run() {
     }
   }
   // Completeness (see the head of this file): every boundary piece of every edge is walked.
-  for (std::uint32_t e = 0; e < edges_.size(); ++e) check_edge(e);
+  // Longest edges first: a checked edge spares the collinear edges lying within it.
+  std::vector<std::uint32_t>& order = check_order_;
+  order.clear();
+  for (std::uint32_t e = 0; e < edges_.size(); ++e)
+    if (!fully_walked(e)) order.push_back(e);
+  auto len2 = [&](std::uint32_t e) {
+    const double dx = edges_[e].p1.x - edges_[e].p0.x, dy = edges_[e].p1.y - edges_[e].p0.y;
+    return dx * dx + dy * dy;
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const double la = len2(a), lb = len2(b);
+    return la > lb || (la == lb && a < b);
+  });
+  for (std::uint32_t e : order) check_edge(e);
   assemble(out);
   out.stats = stats_;
   return out;
