@@ -1229,9 +1229,13 @@ void BlockEngine::assemble(BlockResult& out) {
   // Polygons with area but no boundary piece lie inside the union: find their plan by a vertex.
   for (std::uint32_t p = 0; p < polys_.size(); ++p) {
     if (poly_seen[p] || !polys_[p].has_area) continue;
+    // its vertices may all lie on the union's boundary (a triangle inscribed in a square): its
+    // edges' midpoints are then inside (an unwalked edge has no boundary piece)
     std::vector<Point2> pts;
     for (std::uint32_t ei = polys_[p].first_edge; ei < polys_[p].end_edge && pts.size() < 8; ++ei)
       pts.push_back(edges_[ei].p0);
+    for (std::uint32_t ei = polys_[p].first_edge; ei < polys_[p].end_edge && pts.size() < 16; ++ei)
+      pts.push_back({0.5 * (edges_[ei].p0.x + edges_[ei].p1.x), 0.5 * (edges_[ei].p0.y + edges_[ei].p1.y)});
     const std::size_t k = locate(pts, outers.size());
     if (k < outers.size()) polys_of[k].push_back(p);
   }

@@ -118,9 +118,26 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     });
   }
   std::vector<GroundPlan> plans;
-  for (detail::BlockResult& r : results) {
-    for (GroundPlan& g : r.plans) plans.push_back(std::move(g));
-    for (Problem& p : r.problems) problems.push_back(std::move(p));
+  std::vector<char> member(footprints.size(), 0);
+  std::vector<char> failed(footprints.size(), 0);
+  for (std::size_t bi = 0; bi < results.size(); ++bi) {
+    detail::BlockResult& r = results[bi];
+    for (GroundPlan& g : r.plans) {
+      for (std::uint32_t m : g.members) member[m] = 1;
+      plans.push_back(std::move(g));
+    }
+    for (Problem& p : r.problems) {
+      if (p.code == "UNION_FAILED")
+        for (std::uint32_t fi : blocks[bi].footprints) failed[fi] = 1;
+      problems.push_back(std::move(p));
+    }
+  }
+  // Nothing is dropped silently: a footprint with non-collinear points can still have no area
+  // under the even-odd rule (rings that retrace themselves: A-B-C-B). It is in no plan; say so.
+  for (std::uint32_t fi : fps.indices) {
+    if (member[fi] || failed[fi]) continue;
+    problems.push_back(Problem{footprints[fi].source_id, footprints[fi].source_file, "union", "NO_AREA",
+                               "the footprint's rings enclose no area (they retrace or cancel themselves): not in any plan"});
   }
   progress.report(1.0, "ground plans");
   return plans;

@@ -90,6 +90,33 @@ TEST(UnionEngine, ZeroAreaSliverIsAProblemNotAPlan) {
   EXPECT_EQ(plans[0].members, std::vector<std::uint32_t>{1});
 }
 
+TEST(UnionEngine, SelfRetracingRingIsAProblemNotLostSilently) {
+  // A-B-C-B-A: every edge twice, no area under the even-odd rule (fuzz finding, issue 8)
+  std::vector<Footprint> fps(2);
+  fps[0].source_id = "retrace";
+  fps[0].polygons.push_back(Polygon{{{0, 3}, {10, 0}, {10, 3}, {10, 0}}, {}});
+  fps[1].source_id = "square";
+  fps[1].polygons.push_back(Polygon{{{20, 0}, {30, 0}, {30, 10}, {20, 10}}, {}});
+  std::vector<Problem> problems;
+  const auto plans = build_ground_plans(fps, UnionParams{}, problems);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].members, std::vector<std::uint32_t>{1});
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].source_id, "retrace");
+  EXPECT_EQ(problems[0].code, "NO_AREA");
+  EXPECT_EQ(problems[0].stage, "union");
+}
+
+TEST(UnionEngine, InscribedFootprintIsAMember) {
+  // the triangle's vertices all lie on the square's boundary: located by its edges' midpoints
+  const auto fps = footprints_from_wkt({"POLYGON((0 0, 10 0, 10 10, 0 10, 0 0))", "POLYGON((0 0, 10 5, 0 10, 0 0))"});
+  std::vector<Problem> problems;
+  const auto plans = build_ground_plans(fps, UnionParams{}, problems);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(plans[0].members, (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_TRUE(problems.empty());
+}
+
 TEST(UnionEngine, SliverSpikeOnASquare) {
   expect_union({"POLYGON((0 0, 10 0, 10 5, 15 5, 10 5, 10 10, 0 10, 0 0))"}, 1, 0);
 }
