@@ -19,10 +19,9 @@
 // counter-clockwise; where the boundary touches itself at x0 there are several, and we take the
 // one nearest clockwise to the incoming edge, i.e. we turn around the face of the union we are
 // walking (see choose_outgoing: the paper's "largest right turn" seen from the interior side, which
-// links rings as GEOS does). Coincident rays
-// (collinear overlaps, party walls, duplicates) are one group; a polygon toggled twice by a group
-// (a zero-area spike) does not change. Only edges meeting the walked edges are ever intersected:
-// no arrangement is built.
+// links rings as GEOS does). Coincident rays (collinear overlaps, party walls, duplicates) are one
+// group; a polygon toggled twice by a group (a zero-area spike) does not change. Only edges meeting
+// the walked edges are ever intersected: no arrangement is built.
 //
 // Completeness, exactly (the raster only finds blocks; exactness never depends on pixels). Every
 // point of the union's boundary lies on an input edge, and a boundary ring is traced entirely as
@@ -39,6 +38,11 @@
 // Nothing is sampled, so a hole or island far below the pixel size is found like any other. The
 // cost is paid only on edges that are not entirely walked (party walls, overlaps, interior edges);
 // for separate buildings every edge is walked by the first seed and the check is a lookup.
+//
+// Output in doubles (assemble). Input vertices are exact; crossing points are rounded. A walk with
+// rounded points is checked exactly on its doubles and repaired by local snap rounding (node_walk),
+// split at revisited points into simple rings (split_simple), rid of collapsed rounding slivers, and
+// each plan is checked again; what cannot be repaired at rounding scale becomes a Problem.
 #include "union/block_union.h"
 
 #include <groundplan/error.h>
@@ -47,8 +51,6 @@
 #include <cmath>
 #include <cstring>
 #include <initializer_list>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <numeric>
 #include <string>
