@@ -43,10 +43,6 @@ TEST(FuzzRegressions, Coordinates) { replay("coordinates", groundplan_fuzz_coord
 TEST(FuzzRegressions, Union) { replay("union", groundplan_fuzz_union); }
 TEST(FuzzRegressions, ReadAny) { replay("read_any", groundplan_fuzz_read_any); }
 
-/// Findings not fixed yet (in code owned elsewhere): kept here so that whoever fixes them turns the
-/// test on and moves the files to union/. See tests/corpus/fuzz-regressions/README.md.
-TEST(FuzzRegressions, DISABLED_UnionOpenFindings) { replay("union-open", groundplan_fuzz_union); }
-
 /// The bodies also take the empty input and a few bytes (the smallest cases libFuzzer starts with).
 TEST(FuzzRegressions, TinyInputs) {
   const std::uint8_t bytes[] = {0, 1, 2, 3, 0xff, '<', 'a', '>'};
