@@ -17,8 +17,10 @@ enum class FootprintSource {
   Decompose,      // surface decomposition (paper §4, issue 5) only; ignores what the source says
 };
 
-/// How the footprint was found.
-enum class FootprintMethod { None, GroundSurface, FootPrint, SolidBottom, Decomposition };
+/// How the footprint was found. DecompositionShadow: the decomposition's lower boundary closed no
+/// loop (a model that is not watertight), so the footprint is the mesh's shadow (the union of its
+/// facets' vertical projections), which also covers any overhang.
+enum class FootprintMethod { None, GroundSurface, FootPrint, SolidBottom, Decomposition, DecompositionShadow };
 const char* to_string(FootprintMethod method);
 
 struct FootprintParams {

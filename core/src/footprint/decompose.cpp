@@ -27,10 +27,19 @@
 //     over welded vertices; at a vertex with several ways on, the leftmost turn is taken (ties by
 //     edge order), which keeps rings simple where parts touch at a corner. Chains that do not close
 //     are not local-minimum loops (the edge of a soffit, a part standing on another) and are dropped.
+//     Chains still open are chained again in plan view (endpoints within the weld tolerance in x, y
+//     are one vertex): a bottom stepping at a vertical edge is continuous in plan (terraced sites).
 //  7. Loops projected to 2D: counter-clockwise = outer ring, clockwise = hole; each hole goes to the
 //     smallest outer ring of its own part that contains it. Parts whose outside cannot be told use
 //     nesting depth instead.
+//  8. When no loop closes, or a tenth or more of the lower boundary (plan length) lies in open chains
+//     outside every loop and no higher than the loops (a model that is not watertight: SketchUp /
+//     COLLADA exports whose walls stop short of each other or stand on roofs they share no edge
+//     with), the loops do not say where the building stands: the footprint is its shadow, the exact
+//     union of the facets' vertical projections (DecomposeParams::shadow_fallback; issue 5, Macky).
 #include "footprint/decompose.h"
+
+#include <groundplan/ground_plans.h>
 
 #include <algorithm>
 #include <cmath>
@@ -137,8 +146,12 @@ struct Workspace {
   std::vector<std::uint32_t> stamp, chain_v, chain_e;
   std::uint32_t stamp_gen = 0;
   std::vector<std::uint32_t> endpoints;
+  std::vector<std::uint32_t> plan_rep;  // plan-view merge of footprint-edge endpoints (rule 2)
+  std::vector<std::uint32_t> open_edges;  // footprint edges left in chains that did not close
+  std::vector<DirEdge> open_tmp;
   struct Loop {
     std::uint32_t comp;
+    double zmax;               // highest vertex (relative to the origin)
     std::size_t first, count;  // into loop_pts
     double area;
     double minx, miny, maxx, maxy;
@@ -175,6 +188,15 @@ std::uint32_t uf_find(std::vector<FaceInfo>& f, std::uint32_t i, std::uint8_t& p
   return r;
 }
 
+/// Shadow rings (outer or hole) smaller than this are dropped (rule 3). m².
+constexpr double kShadowMinRing_m2 = 0.01;
+
+double ring_area(const Ring& r) {
+  double a = 0;
+  for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) a += (r[j].x - r[i].x) * (r[j].y + r[i].y);
+  return a / 2;
+}
+
 /// Point in ring (crossing number), ring relative coordinates.
 bool inside(const Point2* ring, std::size_t n, Point2 p) {
   bool in = false;
@@ -208,6 +230,10 @@ class Decomposer {
     collect_footprint_edges();
     chain_loops();
     make_polygons(res.polygons);
+    if (p_.shadow_fallback && (res.polygons.empty() || open_outside_loops())) {
+      res.polygons.clear();
+      make_shadow(res.polygons);
+    }
     return res;
   }
 
@@ -219,6 +245,7 @@ class Decomposer {
   V3 o_;
   double tol_ = 1e-3;
   std::size_t ncomp_ = 0;
+  double lower_boundary_len_ = 0;  // plan length of all footprint edges (set when chains stay open)
 
   bool find_origin() {
     for (const Point3& q : m_.vertices)
@@ -777,9 +804,74 @@ class Decomposer {
 
   // ---- 6. loops ---------------------------------------------------------------------------------
   void chain_loops() {
+    chain_pass(true);
+    if (stats_->open_chains == 0) return;
     auto& cand = ws_.cand;
-    ws_.loops.clear();
-    ws_.loop_pts.clear();
+    lower_boundary_len_ = 0;
+    for (const DirEdge& e : cand) lower_boundary_len_ += plan_length(e);
+    // Rule 2: the edges left open are chained again in plan view. A bottom that steps at a vertical
+    // wall edge (terraced sites, a wall on a plinth on one side only) is broken in 3D but continuous
+    // in plan, and the footprint is a plan-view object. Loops already closed stay as they are.
+    auto& open = ws_.open_tmp;
+    open.clear();
+    for (std::uint32_t e : ws_.open_edges) open.push_back(cand[e]);
+    if (!merge_in_plan(open)) return;
+    const std::size_t loops_before = ws_.loops.size();
+    cand.swap(open);
+    stats_->open_chains = 0;
+    chain_pass(false);
+    stats_->chained_in_plan = ws_.loops.size() - loops_before;
+  }
+
+  double plan_length(const DirEdge& e) const {
+    const V3 &a = ws_.wpos[e.from], &b = ws_.wpos[e.to];
+    return std::hypot(b.x - a.x, b.y - a.y);
+  }
+
+  /// Footprint-edge endpoints within the weld tolerance in x, y become one vertex (the one of
+  /// smallest id); edges that collapse go. False when nothing was merged.
+  bool merge_in_plan(std::vector<DirEdge>& cand) {
+    auto& ends = ws_.endpoints;
+    ends.clear();
+    for (const DirEdge& e : cand) ends.push_back(e.from), ends.push_back(e.to);
+    const auto& P = ws_.wpos;
+    std::sort(ends.begin(), ends.end(), [&](std::uint32_t u, std::uint32_t v) { return P[u].x < P[v].x || (P[u].x == P[v].x && u < v); });
+    ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+    auto& rep = ws_.plan_rep;
+    rep.resize(P.size());
+    for (std::uint32_t v : ends) rep[v] = v;
+    auto find = [&](std::uint32_t x) {
+      while (rep[x] != x) x = rep[x] = rep[rep[x]];
+      return x;
+    };
+    bool any = false;
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (std::size_t j = i + 1; j < ends.size() && P[ends[j]].x - P[ends[i]].x <= tol_; ++j) {
+        if (std::fabs(P[ends[j]].y - P[ends[i]].y) > tol_) continue;
+        const std::uint32_t a = find(ends[i]), b = find(ends[j]);
+        if (a == b) continue;
+        rep[std::max(a, b)] = std::min(a, b);
+        any = true;
+      }
+    if (!any) return false;
+    std::size_t k = 0;
+    for (const DirEdge& e : cand) {
+      const DirEdge m{find(e.from), find(e.to), e.comp};
+      if (m.from != m.to) cand[k++] = m;
+    }
+    cand.resize(k);
+    return true;
+  }
+
+  /// Chains ws_.cand into loops (appended to ws_.loops; cleared first when `fresh`); the edges of
+  /// chains that do not close go to ws_.open_edges.
+  void chain_pass(bool fresh) {
+    auto& cand = ws_.cand;
+    if (fresh) {
+      ws_.loops.clear();
+      ws_.loop_pts.clear();
+    }
+    ws_.open_edges.clear();
     if (cand.empty()) return;
     const std::size_t nv = ws_.wpos.size(), ne = cand.size();
     ws_.out_start.assign(nv + 1, 0);
@@ -821,7 +913,10 @@ class Decomposer {
         if (next == kNone) break;
         e = next;
       }
-      if (!ce.empty()) ++stats_->open_chains;
+      if (!ce.empty()) {
+        ++stats_->open_chains;
+        ws_.open_edges.insert(ws_.open_edges.end(), ce.begin(), ce.end());
+      }
       for (std::uint32_t v : cv) ws_.stamp[v] = 0;
     }
   }
@@ -862,8 +957,10 @@ class Decomposer {
     Workspace::Loop L;
     L.comp = ws_.cand[ws_.chain_e[k]].comp;
     L.first = ws_.loop_pts.size();
+    L.zmax = -std::numeric_limits<double>::infinity();
     for (std::size_t j = k; j < cv.size(); ++j) {
       const V3& p = ws_.wpos[cv[j]];
+      L.zmax = std::max(L.zmax, p.z);
       const Point2 q{p.x, p.y};
       if (ws_.loop_pts.size() > L.first) {
         const Point2& b = ws_.loop_pts.back();
@@ -963,6 +1060,98 @@ class Decomposer {
       }
       out[best].holes.push_back(ring(h));
       ++stats_->holes;
+    }
+  }
+
+  /// True when a tenth or more of the lower boundary (by plan length) lies in open chains outside
+  /// every outer loop and no higher than the loops reach: then the loops miss part of where the
+  /// building stands. Open chains inside a loop (a part standing on another) or above every loop
+  /// (a balcony, a canopy: floating slabs are local minima too, but not ground) do not count.
+  bool open_outside_loops() const {
+    if (ws_.open_edges.empty()) return false;
+    double zmax = -std::numeric_limits<double>::infinity();
+    for (const Workspace::Loop& L : ws_.loops) zmax = std::max(zmax, L.zmax);
+    double outside = 0;
+    for (std::uint32_t e : ws_.open_edges) {
+      const V3 &a = ws_.wpos[ws_.cand[e].from], &b = ws_.wpos[ws_.cand[e].to];
+      if (std::min(a.z, b.z) > zmax + tol_) continue;
+      const Point2 mid{(a.x + b.x) / 2, (a.y + b.y) / 2};
+      bool in = false;
+      for (const Workspace::Loop& L : ws_.loops) {
+        if (L.area <= 0 || mid.x < L.minx || mid.x > L.maxx || mid.y < L.miny || mid.y > L.maxy) continue;
+        if ((in = inside(ws_.loop_pts.data() + L.first, L.count, mid))) break;
+      }
+      if (!in) outside += plan_length(ws_.cand[e]);
+    }
+    return outside >= 0.1 * lower_boundary_len_;
+  }
+
+  // ---- 8. the shadow: last resort --------------------------------------------------------------
+  /// Rule 3: the loops miss where the building stands (a mesh full of gaps, walls
+  /// on roofs they share no edge with, faces that end short of each other: SketchUp exports). The
+  /// shadow, the union of every used facet's vertical projection, is what is certain about where
+  /// the building stands: it is the footprint wherever the building does not overhang its base.
+  /// The union is the project's exact engine on one footprint; should it fail, the projected facets
+  /// go out as they are (overlapping polygons, which the pipeline's union merges anyway).
+  void make_shadow(std::vector<Polygon>& out) {
+    Footprint fp;
+    double minx = std::numeric_limits<double>::infinity(), maxx = -minx, miny = minx, maxy = -minx;
+    for (std::uint32_t f = 0; f < ws_.faces.size(); ++f) {
+      // Walls too: one leaning by a hair bridges a modelling gap of millimetres (an annex drawn a
+      // hair off the hall); the slivers they leave elsewhere are dropped below.
+      if (ws_.faces[f].cls == kSkipped) continue;
+      const MeshFace& mf = m_.faces[f];
+      Polygon poly;
+      for (std::uint32_t r = mf.first_ring; r < mf.first_ring + mf.ring_count; ++r) {
+        if (!welded_ring(r) || ws_.ring_tmp.size() < 3) continue;
+        Ring ring;
+        ring.reserve(ws_.ring_tmp.size());
+        double a = 0;
+        for (std::size_t i = 0; i < ws_.ring_tmp.size(); ++i) {
+          const V3& p = ws_.wpos[ws_.ring_tmp[i]];
+          const V3& q = ws_.wpos[ws_.ring_tmp[i + 1 < ws_.ring_tmp.size() ? i + 1 : 0]];
+          a += p.x * q.y - q.x * p.y;
+          ring.push_back(Point2{p.x + o_.x, p.y + o_.y});
+        }
+        if (!(std::fabs(a / 2) >= p_.min_loop_area_m2)) {
+          if (r == mf.first_ring) break;  // seen edge-on: no area, its holes neither
+          continue;
+        }
+        const bool outer = r == mf.first_ring;
+        if ((a > 0) != outer) std::reverse(ring.begin(), ring.end());
+        if (outer) {
+          for (const Point2& q : ring)
+            minx = std::min(minx, q.x), maxx = std::max(maxx, q.x), miny = std::min(miny, q.y), maxy = std::max(maxy, q.y);
+          poly.outer = std::move(ring);
+        } else {
+          poly.holes.push_back(std::move(ring));
+        }
+      }
+      if (!poly.outer.empty()) fp.polygons.push_back(std::move(poly));
+    }
+    if (fp.polygons.empty()) return;
+    stats_->shadow = true;
+    UnionParams up;
+    up.threads = 1;  // decomposition runs on the caller's thread (the pipeline parallelises buildings)
+    up.device = Device::Cpu;
+    up.resolution_m = std::max({maxx - minx, maxy - miny, 1e-6}) / 256;  // blocks only; exactness does not depend on it
+    std::vector<Problem> problems;
+    std::vector<GroundPlan> plans;
+    try {
+      plans = build_ground_plans(std::vector<Footprint>{fp}, up, problems);
+    } catch (const std::exception&) {
+      plans.clear();
+    }
+    if (plans.empty()) {
+      out = std::move(fp.polygons);
+      return;
+    }
+    // Rings under kShadowMinRing_m2 are what walls leaning by a hair leave along their lines.
+    for (GroundPlan& g : plans) {
+      if (std::fabs(ring_area(g.polygon.outer)) < kShadowMinRing_m2) continue;
+      auto& h = g.polygon.holes;
+      h.erase(std::remove_if(h.begin(), h.end(), [](const Ring& r) { return std::fabs(ring_area(r)) < kShadowMinRing_m2; }), h.end());
+      out.push_back(std::move(g.polygon));
     }
   }
 };

@@ -12,6 +12,11 @@
 // Output: polygons in the mesh's x, y with outer rings counter-clockwise and holes clockwise, closed
 // (no repeated closing vertex), no NaN. Rings of different parts of one mesh may overlap (the union
 // engine merges them). Never throws for bad geometry: an empty result and the stats say why.
+//
+// Rules beyond the paper, in order of use: (1) the lower boundary is chained over welded 3D vertices;
+// (2) chains that do not close are chained again in plan view (endpoints within weld_tolerance_m in
+// x, y are one), so a wall bottom stepping up or down a terraced site at a vertical edge still closes;
+// (3) where the loops miss the ground-level lower boundary, the shadow (DecomposeParams::shadow_fallback).
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
@@ -33,6 +38,12 @@ struct DecomposeParams {
   double weld_tolerance_m = 1e-3;
   /// Loops whose projected area is below this are dropped (slivers, vertical faces seen edge-on). m².
   double min_loop_area_m2 = 1e-6;
+  /// When the lower boundary closes no loop, or a tenth or more of it (plan length) stays in open
+  /// chains outside every loop and no higher than the loops reach (models that are not watertight:
+  /// SketchUp/COLLADA exports with gaps, walls standing on roofs they share no edge with), take the
+  /// mesh's shadow instead: the exact union of the vertical projections of its facets, rings under
+  /// 0.01 m² dropped. It covers overhangs too, so it is only the last resort; stats.shadow says so.
+  bool shadow_fallback = true;
 };
 
 enum class PatchKind : std::uint8_t { Floor, Ceiling, Wall };
@@ -59,6 +70,8 @@ struct DecomposeStats {
   std::size_t open_chains = 0;            // lower-boundary chains that did not close (not footprints)
   std::size_t holes = 0;                  // loops that became holes
   std::size_t dropped_loops = 0;          // loops below min area, or holes inside no outer ring
+  std::size_t chained_in_plan = 0;        // chains closed only when joined in plan view (stepped bottoms)
+  bool shadow = false;                    // the polygons are the shadow (shadow_fallback), not loops
 };
 
 struct DecomposeResult {

@@ -94,7 +94,7 @@ bool decompose_into(const Mesh& mesh, const FootprintParams& params, FootprintRe
   if (!d.polygons.empty()) {
     res.footprint.polygons = std::move(d.polygons);
     res.ok = true;
-    res.method = FootprintMethod::Decomposition;
+    res.method = d.stats.shadow ? FootprintMethod::DecompositionShadow : FootprintMethod::Decomposition;
     return true;
   }
   why = "surface decomposition found no closed lower wall boundary (" + std::to_string(d.stats.faces_used) +
@@ -120,6 +120,7 @@ const char* to_string(FootprintMethod method) {
     case FootprintMethod::FootPrint: return "lod0-footprint";
     case FootprintMethod::SolidBottom: return "solid-bottom";
     case FootprintMethod::Decomposition: return "decomposition";
+    case FootprintMethod::DecompositionShadow: return "decomposition-shadow";
   }
   return "?";
 }

@@ -257,9 +257,15 @@ TEST(DecomposeFootprint, TriangleSoup) {
     EXPECT_LT(c.symdiff, 0.05) << "seed " << seed;
     EXPECT_EQ(c.invalid, 0u) << "seed " << seed;
   }
-  // Without welding (tolerance below the jitter) nothing connects: no footprint, and no garbage.
+  // Without welding (tolerance below the jitter) nothing connects: no loop, and no garbage. The
+  // shadow fallback (rule 3) still finds the courtyard from the roof triangles alone.
   DecomposeParams p;
   p.weld_tolerance_m = 1e-9;
+  const DecomposeResult unwelded = decompose_footprint(soup(quads, 2e-4, 1), p);
+  EXPECT_TRUE(unwelded.stats.shadow);
+  EXPECT_EQ(unwelded.stats.loops, 0u);
+  EXPECT_LT(compare(unwelded, kCourtyard).symdiff, 0.05);
+  p.shadow_fallback = false;
   EXPECT_TRUE(decompose_footprint(soup(quads, 2e-4, 1), p).polygons.empty());
 }
 
@@ -446,6 +452,112 @@ TEST(DecomposeFootprint, LargeCoordinates) {
   double a = ring_area(r.polygons[0].outer);
   for (const Ring2& h : r.polygons[0].holes) a += ring_area(h);
   EXPECT_NEAR(a, 400 - 64, 1e-6);
+}
+
+// ---- Rules beyond the paper (issue 5, Macky Auditorium) -------------------------------------------
+
+/// A wall as one polygon in the vertical plane through a -> b (seen from outside: a on the left),
+/// bottom given as (distance along a->b, z) points from a to b, top at z_top.
+Ring3 wall(Point2 a, Point2 b, const std::vector<std::pair<double, double>>& bottom, double z_top) {
+  const double len = std::hypot(b.x - a.x, b.y - a.y);
+  auto at = [&](double s, double z) { return Point3{a.x + (b.x - a.x) * s / len, a.y + (b.y - a.y) * s / len, z}; };
+  Ring3 r;
+  for (auto [s, z] : bottom) r.push_back(at(s, z));
+  r.push_back(at(bottom.back().first, z_top));
+  r.push_back(at(bottom.front().first, z_top));
+  return r;
+}
+
+void add_roof(Mesh& m, const Ring2& outer, double z) {
+  Ring3 r;
+  for (const Point2& p : outer) r.push_back({p.x, p.y, z});
+  m.add_face({r}, SurfaceKind::Roof, 2);
+}
+
+TEST(DecomposeFootprint, BottomSteppingAtAVerticalEdgeClosesInPlan) {
+  // Rule 2. A terraced site without floor: ground at z 0 for x < 5, z 1 beyond; the long walls step up
+  // at x = 5 along a vertical edge. In 3D the lower boundary is two open chains; in plan it is the
+  // square. Without the shadow fallback, so that only rule 2 can give it.
+  Mesh m;
+  m.add_face({wall({0, 0}, {10, 0}, {{0, 0}, {5, 0}, {5, 1}, {10, 1}}, 6)}, SurfaceKind::Wall, 2);
+  m.add_face({wall({10, 0}, {10, 10}, {{0, 1}, {10, 1}}, 6)}, SurfaceKind::Wall, 2);
+  m.add_face({wall({10, 10}, {0, 10}, {{0, 1}, {5, 1}, {5, 0}, {10, 0}}, 6)}, SurfaceKind::Wall, 2);
+  m.add_face({wall({0, 10}, {0, 0}, {{0, 0}, {10, 0}}, 6)}, SurfaceKind::Wall, 2);
+  add_roof(m, rect(0, 0, 10, 10), 6);
+  DecomposeParams p;
+  p.shadow_fallback = false;
+  const DecomposeResult r = decompose_footprint(m, p);
+  const Check c = compare(r, kSquare);
+  EXPECT_EQ(c.polygons, 1u);
+  EXPECT_LT(c.symdiff, kEps);
+  EXPECT_EQ(c.invalid, 0u);
+  EXPECT_EQ(r.stats.chained_in_plan, 1u);
+  EXPECT_EQ(r.stats.open_chains, 0u);
+  EXPECT_FALSE(r.stats.shadow);
+}
+
+/// A size x size x 6 box as SketchUp exports often come: each wall a separate quad stopping `gap` short
+/// of the corners, a roof over all of it, no floor. Nothing connects the walls' bottoms.
+Mesh gappy_box(double x0, double y0, double size, double gap) {
+  Mesh m;
+  const Ring2 o = rect(x0, y0, x0 + size, y0 + size);
+  for (std::size_t i = 0; i < 4; ++i)
+    m.add_face({wall(o[i], o[(i + 1) % 4], {{gap, 0}, {size - gap, 0}}, 6)}, SurfaceKind::Unknown, 255);
+  add_roof(m, o, 6);
+  return m;
+}
+
+TEST(DecomposeFootprint, LowerBoundaryWithGapsFallsBackToTheShadow) {
+  // Rule 3. The walls' bottoms are four open chains, 5 cm apart at the corners: no loop. The
+  // footprint is the shadow: the roof's square.
+  const Mesh m = gappy_box(0, 0, 10, 0.05);
+  const DecomposeResult r = decompose_footprint(m);
+  const Check c = compare(r, kSquare);
+  EXPECT_TRUE(r.stats.shadow);
+  EXPECT_EQ(r.stats.loops, 0u);
+  EXPECT_EQ(r.stats.open_chains, 4u);
+  EXPECT_EQ(c.polygons, 1u);
+  EXPECT_LT(c.symdiff, kEps);
+  EXPECT_EQ(c.invalid, 0u);
+  // Without the fallback: nothing, as before.
+  DecomposeParams p;
+  p.shadow_fallback = false;
+  EXPECT_TRUE(decompose_footprint(m, p).polygons.empty());
+  // A closed shed beside it closes a loop, but most of the lower boundary still lies in open chains
+  // outside every loop: the loops miss the building, so the shadow of both.
+  Mesh with_shed = m;
+  append(with_shed, prism(rect(20, 0, 22, 2), {}, flat(0), 3, true, true));
+  const DecomposeResult s = decompose_footprint(with_shed);
+  EXPECT_TRUE(s.stats.shadow);
+  EXPECT_LT(compare(s, kSquare, {"POLYGON((20 0,22 0,22 2,20 2,20 0))"}).symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, OpenChainsInsideTheLoopsKeepTheLoops) {
+  // Rule 3's condition. The cantilevered storey (footprint 10 x 10, shadow 14 x 10) carries a gappy
+  // roof box standing on its roof, sharing no edge with it: the box's wall bottoms are open chains, but
+  // inside the closed ground loop, so the loop stands and the overhang stays out.
+  Mesh m = overhang(false, false);
+  Mesh top = gappy_box(2, 2, 6, 0.05);
+  for (Point3& q : top.vertices) q.z += 6;
+  append(m, top);
+  const DecomposeResult r = decompose_footprint(m);
+  const Check c = compare(r, kSquare);
+  EXPECT_FALSE(r.stats.shadow);
+  EXPECT_EQ(r.stats.open_chains, 4u);
+  EXPECT_LT(c.symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, OpenChainsAboveTheLoopsKeepTheLoops) {
+  // Rule 3's condition, the other half. A closed box with a gappy bay (3 x 3 m, from z 3) hung on its
+  // side, outside the ground loop but above it: a balcony is no ground, so no shadow.
+  Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, true, true);
+  Mesh bay = gappy_box(10, 2, 3, 0.05);
+  for (Point3& q : bay.vertices) q.z += 3;
+  append(m, bay);
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_FALSE(r.stats.shadow);
+  EXPECT_GE(r.stats.open_chains, 1u);
+  EXPECT_LT(compare(r, kSquare).symdiff, kEps);
 }
 
 }  // namespace
