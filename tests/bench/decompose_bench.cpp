@@ -3,7 +3,9 @@
 // on one core, against the explicit GroundSurface path on the same buildings. Meshes are read once
 // into memory (GroundSurface faces removed for the decomposition, so it cannot take them); the
 // figure is the median of repeated passes. Usage: decompose_bench [file ...] (default: every real
-// CityGML sample with GroundSurfaces, grouped per file, plus the LoD1 tiles).
+// CityGML sample with GroundSurfaces, grouped per file, plus the LoD1 tiles). `--passes N` runs exactly N
+// decomposition passes per file instead and no timing (for instruction counts under
+// `valgrind --tool=callgrind --toggle-collect='groundplan::footprint::decompose_footprint*'`).
 #include "footprint/decompose.h"
 
 #include <groundplan/footprint.h>
@@ -13,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -86,9 +89,18 @@ Set load(const std::string& path, bool ground_only) {
   return s;
 }
 
+int g_passes = 0;  // > 0: that many decomposition passes, no timing
+
 void run(const Set& s) {
   if (s.bare.empty()) return;
   std::size_t sink = 0;
+  if (g_passes > 0) {
+    for (int p = 0; p < g_passes; ++p)
+      for (const Mesh& m : s.bare) sink += footprint::decompose_footprint(m).polygons.size();
+    std::printf("%-58s %6zu bldg x %d passes = %zu calls  [%zu]\n", s.name.c_str(), s.bare.size(), g_passes,
+                s.bare.size() * g_passes, sink % 10);
+    return;
+  }
   const double dec = median_seconds([&] {
     for (const Mesh& m : s.bare) sink += footprint::decompose_footprint(m).polygons.size();
   });
@@ -106,8 +118,13 @@ void run(const Set& s) {
 
 int main(int argc, char** argv) {
   std::vector<std::pair<std::string, bool>> files;
-  if (argc > 1) {
-    for (int i = 1; i < argc; ++i) files.emplace_back(argv[i], false);
+  int first = 1;
+  if (argc > 2 && std::string(argv[1]) == "--passes") {
+    g_passes = std::max(1, std::atoi(argv[2]));
+    first = 3;
+  }
+  if (argc > first) {
+    for (int i = first; i < argc; ++i) files.emplace_back(argv[i], false);
   } else {
     const std::string d = GROUNDPLAN_SHARED_DATA_DIR;
     for (const char* f : {"/citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml",
