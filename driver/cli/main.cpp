@@ -325,7 +325,8 @@ int run(int argc, char** argv) {
                 c.summary().c_str());
     verify_json = {{"match", c.matches()},        {"symdiff_area_m2", c.symdiff_area}, {"area_m2", c.area_ours},
                    {"area_geos_m2", c.area_geos}, {"polygons", c.polygons_ours},      {"polygons_geos", c.polygons_geos},
-                   {"holes", c.holes_ours},       {"holes_geos", c.holes_geos},        {"invalid", c.invalid_ours}};
+                   {"holes", c.holes_ours},       {"holes_geos", c.holes_geos},        {"invalid", c.invalid_ours},
+                   {"holes_geos_artifacts", c.holes_geos_artifacts}};
     if (!c.matches()) rc = 3;
   }
   if (!stats_path.empty() && !write_stats(stats_path, result, write_s, verify ? &verify_json : nullptr)) return 1;
