@@ -172,10 +172,13 @@ std::size_t count_holes(const PipelineResult& r) {
 bool write_stats(const std::string& path, const PipelineResult& result, double write_s, const nlohmann::json* verify) {
   nlohmann::json j;
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
-                 {"dropped", result.buildings_dropped},  {"ground_plans", result.plans.size()},
+                 {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
+                 {"ground_plans", result.plans.size()},
                  {"holes", count_holes(result)},          {"problems", count_defects(result)}};
-  j["timings_s"] = {{"read", result.timings.read_s}, {"footprints", result.timings.footprints_s},
-                    {"union", result.timings.union_s}, {"write", write_s}};
+  j["timings_s"] = {{"read", result.timings.read_s},     {"footprints", result.timings.footprints_s},
+                    {"blocks", result.timings.blocks_s}, {"union", result.timings.union_s},
+                    {"write", write_s}};
+  j["raster_backend"] = result.raster_backend;
   if (verify) j["verify"] = *verify;
   std::ofstream f(path);
   f << j.dump(2) << '\n';
@@ -309,9 +312,12 @@ int run(int argc, char** argv) {
                 result.crs_name.empty() ? "unknown" : result.crs_name.c_str());
     std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %zu problems\n",
                 result.footprints.size(), result.plans.size(), holes, count_defects(result));
-    std::printf("groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, union %.2f s, write %.2f s)\n",
-                ogr.dst.c_str(), std::chrono::duration<double>(clock::now() - t0).count(), result.timings.read_s,
-                result.timings.footprints_s, result.timings.union_s, write_s);
+    std::printf(
+        "groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, blocks %.2f s (%zu, %s), union %.2f s, "
+        "write %.2f s)\n",
+        ogr.dst.c_str(), std::chrono::duration<double>(clock::now() - t0).count(), result.timings.read_s,
+        result.timings.footprints_s, result.timings.blocks_s, result.blocks, result.raster_backend.c_str(),
+        result.timings.union_s, write_s);
     print_problems(result);
   }
 

@@ -204,8 +204,14 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
   result.timings.read_s = seconds_since(t_read) - footprint_s;
 
   const auto t_union = clock_type::now();
-  result.plans = build_ground_plans(result.footprints, options.union_params, result.problems, progress.sub(0.6, 1.0));
-  result.timings.union_s = seconds_since(t_union);
+  UnionStats union_stats;
+  UnionParams union_params = options.union_params;
+  union_params.stats = &union_stats;
+  result.plans = build_ground_plans(result.footprints, union_params, result.problems, progress.sub(0.6, 1.0));
+  result.blocks = union_stats.blocks;
+  result.raster_backend = union_stats.backend;
+  result.timings.blocks_s = union_stats.blocks_s;
+  result.timings.union_s = seconds_since(t_union) - union_stats.blocks_s;
   progress.report(1.0, "done");
   return result;
 }

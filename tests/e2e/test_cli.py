@@ -20,8 +20,10 @@ def test_stats_json(tmp_path):
     stats = tmp_path / "s.json"
     run([BIN, "--stats", stats, "-f", "GPKG", tmp_path / "o.gpkg", PLATEAU_SMALL])
     j = json.loads(stats.read_text())
-    assert set(j["counts"]) >= {"buildings", "footprints", "ground_plans", "holes", "problems"}
-    assert set(j["timings_s"]) >= {"read", "footprints", "union", "write"}
+    assert set(j["counts"]) >= {"buildings", "footprints", "blocks", "ground_plans", "holes", "problems"}
+    assert set(j["timings_s"]) >= {"read", "footprints", "blocks", "union", "write"}
+    assert j["raster_backend"] == "cpu"  # no GPU here (and none in CI)
+    assert 1 <= j["counts"]["blocks"] <= j["counts"]["ground_plans"]  # a block gives one plan or more
     assert j["counts"]["buildings"] == 25 and j["counts"]["ground_plans"] == 23
 
 

@@ -3,16 +3,26 @@
 // The union stage: footprints in, non-overlapping ground plans out (paper §3, §5, §6).
 #include <groundplan/progress.h>
 #include <groundplan/types.h>
+#include <string>
 #include <vector>
 
 namespace groundplan {
 
 enum class Device { Auto, Cpu, Cuda };
 
+/// What the union stage did, for --stats (filled when UnionParams::stats is set).
+struct UnionStats {
+  std::size_t blocks = 0;       // blocks found by the raster backend (paper §5)
+  double blocks_s = 0;          // time to find them
+  double union_s = 0;           // time for the boundary evaluation of all blocks (§6)
+  std::string backend;          // "cpu" or "cuda"
+};
+
 struct UnionParams {
   double resolution_m = 0;     // raster pixel for blocks/seeds; 0 = automatic (paper §5). Exactness never depends on it.
   Device device = Device::Auto;
   int threads = 0;             // 0 = all cores
+  UnionStats* stats = nullptr; // out, optional
 };
 
 /// The exact union of `footprints` (working CRS, metres), one GroundPlan per connected region.

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -78,7 +79,14 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     fps.boxes.push_back(all.boxes[k]);
   }
   const PixelGrid grid = make_pixel_grid(fps, params.resolution_m);
+  const auto t_blocks = std::chrono::steady_clock::now();
   std::vector<Block> blocks = backend->find_blocks(fps, grid, progress.sub(0.0, 0.1));
+  const auto t_union = std::chrono::steady_clock::now();
+  if (params.stats) {
+    params.stats->blocks = blocks.size();
+    params.stats->blocks_s = std::chrono::duration<double>(t_union - t_blocks).count();
+    params.stats->backend = backend->name();
+  }
 
   // Largest blocks first, so that one big block does not finish last on one core.
   std::vector<std::size_t> order(blocks.size());
@@ -140,6 +148,8 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
                                "the footprint's rings enclose no area (they retrace or cancel themselves): not in any plan"});
   }
   progress.report(1.0, "ground plans");
+  if (params.stats)
+    params.stats->union_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_union).count();
   return plans;
 }
 

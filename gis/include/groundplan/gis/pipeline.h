@@ -23,7 +23,7 @@ struct PipelineOptions {
 };
 
 struct StageTimings {
-  double read_s = 0, footprints_s = 0, union_s = 0;
+  double read_s = 0, footprints_s = 0, blocks_s = 0, union_s = 0;  // union_s: boundary evaluation only
 };
 
 struct PipelineResult {
@@ -34,6 +34,8 @@ struct PipelineResult {
                                       // given up by the reader with a Problem (NO_GEOMETRY, TRUNCATED ...)
   std::size_t buildings_dropped = 0;  // of those, the ones with no footprint, each named by a Problem (stage read,
                                       // georeference or footprint): buildings_read = footprints + buildings_dropped
+  std::size_t blocks = 0;             // blocks of touching footprints (paper §5)
+  std::string raster_backend;         // "cpu" or "cuda"
   std::string crs_wkt;                // working CRS (WKT2), empty when the input has no CRS
   std::string crs_name;               // e.g. "EPSG:25833", for messages
   StageTimings timings;
