@@ -2,10 +2,14 @@
 // Footprints by surface decomposition (paper §4, issue 5).
 //
 // Pipeline per mesh, all on per-thread scratch buffers (issue 5 asks for >= 200k LoD2 buildings/s per
-// core, i.e. a few microseconds each, so nothing here allocates once the buffers are warm):
-//  1. Weld vertices within weld_tolerance_m (grid hash, cells of 2 x tol, the 8 nearest cells probed):
-//     readers give every polygon its own copy of its corners, and triangle soup has no connectivity at
-//     all (the paper's stated limitation).
+// core, i.e. a few microseconds each, so nothing here allocates once the buffers are warm, and hash
+// tables are not even cleared: their slots carry a generation number, see GenTable):
+//  1. Weld vertices within weld_tolerance_m: readers give every polygon its own copy of its corners
+//     (bit for bit the same: one hash of the raw coordinates finds them), and triangle soup has no
+//     connectivity at all (the paper's stated limitation: coordinates not seen before go to a grid of
+//     16 x tol cells, the neighbouring cells probed only within tol of a side). One pass per ring
+//     welds, takes the Newell normal and bounding box, and tells walls from the rest (no square root:
+//     which edges a wall rises from is decided on squares).
 //  2. Boundary-oriented half-edges per face ring (holes turned against the outer ring), grouped by
 //     undirected welded edge. Faces written twice are resolved (same way: one kept; opposite ways:
 //     a wall between two closed parts, both dropped). Edges seen by one facet only are split where
@@ -70,6 +74,9 @@ enum : std::uint8_t { kFloor = 0, kCeiling = 1, kWall = 2, kSkipped = 255 };
 struct FaceInfo {
   V3 n;                 // Newell normal of the outer ring as written (welded positions)
   double len = 0;       // |n| = twice the area
+  V3 net;               // n less the holes' normals: twice the face's area vector (signed volume)
+  V3 c;                 // a vertex of the face (its outer ring's first)
+  V3 lo, hi;            // bounding box of the outer ring
   std::uint32_t uf = 0; // union-find parent
   std::uint8_t parity = 0;  // orientation relative to the parent: 1 = opposite
   std::int8_t sign = 1;     // +1: written orientation faces out; -1: flipped
@@ -79,22 +86,31 @@ struct FaceInfo {
 struct HalfEdge {
   std::uint32_t a, b;   // welded vertices, boundary orientation of the face as written
   std::uint32_t face;
-  float up;             // z of the unit in-plane direction into the face (orientation-independent)
+  /// Whether a wall facet rises from this edge: +1 when the unit in-plane direction into the face
+  /// has a z component above kRise, -1 below -kRise (it goes down), 0 otherwise and for non-walls.
+  /// Orientation-independent.
+  std::int8_t up;
 };
 
 struct DirEdge {
   std::uint32_t from, to, comp;
 };
 
+struct ExactEntry {
+  std::uint32_t vertex, rep;  // a mesh vertex with these exact coordinates, its welded id
+  std::uint32_t gen;
+};
+
 struct WeldEntry {
   std::int32_t kx, ky, kz;
   std::uint32_t rep;
+  std::uint32_t gen;
 };
 
 struct FaceEntry {
   std::uint64_t hash;
-  std::uint32_t face, first, count, rings;
-  bool fwd;
+  std::uint32_t face, first, count, rings;  // first: the welded outer ring in `canon`
+  std::uint32_t gen;
 };
 
 struct Dup {
@@ -103,8 +119,37 @@ struct Dup {
 };
 
 struct EdgeEntry {
-  std::uint64_t key;
+  std::uint64_t key;    // smaller vertex << 32 | larger
   std::uint32_t group;
+  std::uint32_t gen;
+};
+
+/// An open-addressing table kept across meshes: a slot is empty unless it carries the current
+/// generation, so starting a mesh clears nothing (a few kilobytes of memset per building would
+/// cost as much as the rest of a small one), and the mask covers only the slots this mesh needs.
+template <class Entry>
+struct GenTable {
+  std::vector<Entry> slots;
+  std::size_t mask = 0;
+  std::uint32_t gen = 0;
+  /// Room for `n` keys at most half full; returns the generation that marks this use's slots.
+  std::uint32_t start(std::size_t n) {
+    std::size_t size = 64;
+    while (size < 2 * n) size <<= 1;
+    if (slots.size() < size) slots.resize(size, Entry{});
+    mask = size - 1;
+    if (++gen == 0) {  // wrapped: every old mark must go
+      for (Entry& e : slots) e.gen = 0;
+      gen = 1;
+    }
+    return gen;
+  }
+  bool empty(std::size_t s) const { return slots[s].gen != gen; }
+};
+
+struct XEnd {
+  double x, y, z;
+  std::uint32_t v;
 };
 
 inline std::uint64_t mix64(std::uint64_t h) {
@@ -116,7 +161,7 @@ inline std::uint64_t mix64(std::uint64_t h) {
   return h;
 }
 
-inline std::size_t pow2_at_least(std::size_t n) {
+[[maybe_unused]] inline std::size_t pow2_at_least(std::size_t n) {
   std::size_t s = 16;
   while (s < n) s <<= 1;
   return s;
@@ -124,18 +169,20 @@ inline std::size_t pow2_at_least(std::size_t n) {
 
 struct Workspace {
   std::vector<std::uint32_t> weld;      // mesh vertex -> welded id
+  GenTable<EdgeEntry> edge_table;
   std::vector<V3> wpos;                 // welded positions, relative to the origin
-  std::vector<WeldEntry> weld_table;
+  GenTable<WeldEntry> weld_table;
+  GenTable<ExactEntry> exact_table;
   std::vector<FaceInfo> faces;
   std::vector<HalfEdge> halfedges, split_tmp;
-  std::vector<EdgeEntry> edge_table;
-  std::vector<FaceEntry> face_table;
+  GenTable<FaceEntry> face_table;
   std::vector<std::uint32_t> canon;     // canonical welded outer rings, for duplicate faces
   std::vector<Dup> dups;
-  std::vector<std::uint32_t> he_group, group_count, group_start, group_members;
+  std::vector<std::uint32_t> he_group, group_count, group_start, group_members, bucket_start;
   std::vector<std::uint32_t> ring_tmp;
   std::vector<V3> comp_lo, comp_hi;
   std::vector<double> comp_vol, comp_area;
+  std::vector<V3> comp_net;
   std::vector<std::int8_t> comp_sign;
   std::vector<std::uint32_t> comp_index;  // union-find root -> dense component id
   std::vector<std::uint32_t> face_comp;   // face -> dense component id
@@ -146,6 +193,7 @@ struct Workspace {
   std::vector<std::uint32_t> stamp, chain_v, chain_e;
   std::uint32_t stamp_gen = 0;
   std::vector<std::uint32_t> endpoints;
+  std::vector<XEnd> xends;
   std::vector<std::uint32_t> plan_rep;  // plan-view merge of footprint-edge endpoints (rule 2)
   std::vector<std::uint32_t> open_edges;  // footprint edges left in chains that did not close
   std::vector<DirEdge> open_tmp;
@@ -243,7 +291,8 @@ class Decomposer {
   Workspace& ws_;
   DecomposeStats* stats_ = nullptr;
   V3 o_;
-  double tol_ = 1e-3;
+  double tol_ = 1e-3, tol2_ = 1e-6, inv_cell_ = 1, cos2_tol_ = 0;
+  static constexpr double kCell = 16;  // weld grid cell, in weld tolerances
   std::size_t ncomp_ = 0;
   double lower_boundary_len_ = 0;  // plan length of all footprint edges (set when chains stay open)
 
@@ -258,10 +307,29 @@ class Decomposer {
 
   // ---- 1. welding -------------------------------------------------------------------------------
   static std::size_t cell_hash(std::int32_t x, std::int32_t y, std::int32_t z) {
-    std::uint64_t h = std::uint64_t(std::uint32_t(x)) * 0x9E3779B97F4A7C15ULL ^
-                      std::uint64_t(std::uint32_t(y)) * 0xC2B2AE3D27D4EB4FULL ^
-                      std::uint64_t(std::uint32_t(z)) * 0x165667B19E3779F9ULL;
-    return static_cast<std::size_t>(h ^ (h >> 29));
+    std::uint64_t h = (std::uint64_t(std::uint32_t(x)) | std::uint64_t(std::uint32_t(y)) << 32) * 0x9E3779B97F4A7C15ULL;
+    h ^= std::uint64_t(std::uint32_t(z)) * 0xC2B2AE3D27D4EB4FULL;
+    return static_cast<std::size_t>(h ^ (h >> 32));
+  }
+
+  /// floor() without the libm call (x86-64 baseline has no roundsd); exact for |v| < 2^31.
+  static double floor_fast(double v) {
+    if (!(std::fabs(v) < 2.0e9)) return std::floor(v);
+    const double t = static_cast<double>(static_cast<std::int64_t>(v));
+    return t > v ? t - 1 : t;
+  }
+
+  /// The welded vertex in grid cell (cx, cy, cz) within tol of p, kNone if none.
+  std::uint32_t probe(std::int32_t cx, std::int32_t cy, std::int32_t cz, const V3& p) const {
+    const auto& T = ws_.weld_table;
+    for (std::size_t h = cell_hash(cx, cy, cz) & T.mask;; h = (h + 1) & T.mask) {
+      const WeldEntry& e = T.slots[h];
+      if (e.gen != T.gen) return kNone;
+      if (e.kx == cx && e.ky == cy && e.kz == cz) {
+        const V3 d = ws_.wpos[e.rep] - p;
+        if (dot(d, d) <= tol2_) return e.rep;
+      }
+    }
   }
 
   /// Welded id of mesh vertex vi, kBad for a non-finite one. Grid cells are kCell x tol wide, so a
@@ -270,37 +338,50 @@ class Decomposer {
     std::uint32_t& w = ws_.weld[vi];
     if (w != kNone) return w;
     const Point3& q = m_.vertices[vi];
-    if (!(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z))) return w = kBad;
+    // Readers give every polygon its own copies of shared corners, bit for bit the same: one hash of
+    // the raw coordinates finds those, and only coordinates not seen before go to the grid.
+    std::uint64_t bx, by, bz;
+    std::memcpy(&bx, &q.x, 8), std::memcpy(&by, &q.y, 8), std::memcpy(&bz, &q.z, 8);
+    auto& X = ws_.exact_table;
+    std::size_t es = mix64(bx ^ (by * 0x9E3779B97F4A7C15ULL) ^ (bz * 0xC2B2AE3D27D4EB4FULL)) & X.mask;
+    for (;; es = (es + 1) & X.mask) {
+      const ExactEntry& e = X.slots[es];
+      if (e.gen != X.gen) break;
+      if (m_.vertices[e.vertex] == q) return w = e.rep;
+    }
+    w = weld_new(q);
+    X.slots[es] = ExactEntry{vi, w, X.gen};
+    return w;
+  }
+
+  /// Welded id of a point not seen before (by its exact coordinates).
+  std::uint32_t weld_new(const Point3& q) {
+    std::uint32_t w;
+    if (!(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z))) return kBad;
     const V3 p{q.x - o_.x, q.y - o_.y, q.z - o_.z};
-    constexpr double kCell = 16;
-    const double inv = 1.0 / (kCell * tol_);
-    const double tx = p.x * inv, ty = p.y * inv, tz = p.z * inv;
-    const double fx = std::floor(tx), fy = std::floor(ty), fz = std::floor(tz);
+    const double tx = p.x * inv_cell_, ty = p.y * inv_cell_, tz = p.z * inv_cell_;
+    const double fx = floor_fast(tx), fy = floor_fast(ty), fz = floor_fast(tz);
     // Cells beyond int32 range (a mesh kilometres across with a tiny tolerance) just clamp: the
     // exact distance test keeps welding correct, only the hashing gets slower.
     auto clampi = [](double v) { return static_cast<std::int32_t>(std::clamp(v, -2.0e9, 2.0e9)); };
     const std::int32_t kx = clampi(fx), ky = clampi(fy), kz = clampi(fz);
+    std::uint32_t found = probe(kx, ky, kz, p);
+    if (found != kNone) return found;
     auto side = [](double frac) { return frac < 1 / kCell ? -1 : frac > 1 - 1 / kCell ? 1 : 0; };
     const std::int32_t sx = side(tx - fx), sy = side(ty - fy), sz = side(tz - fz);
-    const std::size_t mask = ws_.weld_table.size() - 1;
-    const double tol2 = tol_ * tol_;
-    for (int c = 0; c < 8; ++c) {
-      if (((c & 1) && !sx) || ((c & 2) && !sy) || ((c & 4) && !sz)) continue;
-      const std::int32_t cx = kx + ((c & 1) ? sx : 0), cy = ky + ((c & 2) ? sy : 0), cz = kz + ((c & 4) ? sz : 0);
-      for (std::size_t h = cell_hash(cx, cy, cz) & mask;; h = (h + 1) & mask) {
-        const WeldEntry& e = ws_.weld_table[h];
-        if (e.rep == kNone) break;
-        if (e.kx == cx && e.ky == cy && e.kz == cz) {
-          const V3 d = ws_.wpos[e.rep] - p;
-          if (dot(d, d) <= tol2) return w = e.rep;
-        }
+    if (const int near = (sx != 0) | (sy != 0) << 1 | (sz != 0) << 2) {
+      for (int c = 1; c < 8; ++c) {
+        if (c & ~near) continue;
+        found = probe(kx + ((c & 1) ? sx : 0), ky + ((c & 2) ? sy : 0), kz + ((c & 4) ? sz : 0), p);
+        if (found != kNone) return found;
       }
     }
     w = static_cast<std::uint32_t>(ws_.wpos.size());
     ws_.wpos.push_back(p);
-    std::size_t h = cell_hash(kx, ky, kz) & mask;
-    while (ws_.weld_table[h].rep != kNone) h = (h + 1) & mask;
-    ws_.weld_table[h] = WeldEntry{kx, ky, kz, w};
+    auto& T = ws_.weld_table;
+    std::size_t h = cell_hash(kx, ky, kz) & T.mask;
+    while (!T.empty(h)) h = (h + 1) & T.mask;
+    T.slots[h] = WeldEntry{kx, ky, kz, w, T.gen};
     return w;
   }
 
@@ -321,6 +402,44 @@ class Decomposer {
     return true;
   }
 
+  /// welded_ring() and, in the same pass, the ring's Newell normal and bounding box (repeated
+  /// vertices add exact zeros to the normal, so it does not matter that they are still there).
+  bool welded_ring_normal(std::uint32_t r, V3& n, V3& lo, V3& hi) {
+    auto& out = ws_.ring_tmp;
+    out.clear();
+    n = V3{};
+    const std::uint32_t a = m_.ring_offsets[r], b = m_.ring_offsets[r + 1];
+    if (a >= b) return true;
+    const std::size_t nv = m_.vertices.size();
+    const V3* W = nullptr;
+    V3 first, prev;
+    for (std::uint32_t k = a; k < b; ++k) {
+      const std::uint32_t vi = m_.indices[k];
+      if (vi >= nv) return false;
+      const std::uint32_t w = weld_vertex(vi);
+      if (w == kBad) return false;
+      W = ws_.wpos.data();  // weld_vertex may grow wpos
+      const V3 p = W[w];
+      if (k == a) {
+        first = p;
+        lo = hi = p;
+      } else {
+        n.x += (prev.y - p.y) * (prev.z + p.z);
+        n.y += (prev.z - p.z) * (prev.x + p.x);
+        n.z += (prev.x - p.x) * (prev.y + p.y);
+        lo.x = std::min(lo.x, p.x), lo.y = std::min(lo.y, p.y), lo.z = std::min(lo.z, p.z);
+        hi.x = std::max(hi.x, p.x), hi.y = std::max(hi.y, p.y), hi.z = std::max(hi.z, p.z);
+      }
+      prev = p;
+      if (out.empty() || out.back() != w) out.push_back(w);
+    }
+    n.x += (prev.y - first.y) * (prev.z + first.z);
+    n.y += (prev.z - first.z) * (prev.x + first.x);
+    n.z += (prev.x - first.x) * (prev.y + first.y);
+    while (out.size() > 1 && out.back() == out.front()) out.pop_back();
+    return true;
+  }
+
   V3 newell_tmp() const {
     V3 n;
     const auto& r = ws_.ring_tmp;
@@ -335,36 +454,49 @@ class Decomposer {
   }
 
   // ---- 2. faces and half-edges ------------------------------------------------------------------
-  /// Remembers the face's welded outer ring in canonical form (smallest vertex first, either
-  /// direction); faces seen before with the same ring and ring count are noted in `dups` for
-  /// resolve_duplicates().
+  /// Remembers the face's welded outer ring (ring_tmp); a face seen before with the same ring (any
+  /// start, either direction) and ring count is noted in `dups` for resolve_duplicates(), with
+  /// `fwd` telling whether it runs the way the first one does. The hash does not depend on start
+  /// or direction, so nothing is rotated unless two hashes meet.
   void note_face(std::uint32_t f, std::uint32_t ring_count) {
     const auto& r = ws_.ring_tmp;
     const std::size_t k = r.size();
-    std::size_t start = 0;
-    for (std::size_t i = 1; i < k; ++i)
-      if (r[i] < r[start]) start = i;
-    const bool fwd = r[(start + 1) % k] < r[(start + k - 1) % k];
-    const std::size_t first = ws_.canon.size();
-    for (std::size_t i = 0; i < k; ++i) ws_.canon.push_back(r[fwd ? (start + i) % k : (start + k - i) % k]);
-    std::uint64_t h = mix64(k * 0x9E3779B97F4A7C15ULL + ring_count);
-    for (std::size_t i = first; i < first + k; ++i) h = mix64(h ^ ws_.canon[i]);
-    const std::size_t mask = ws_.face_table.size() - 1;
-    for (std::size_t s = h & mask;; s = (s + 1) & mask) {
-      FaceEntry& e = ws_.face_table[s];
-      if (e.face == kNone) {
-        e = FaceEntry{h, f, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(k), ring_count, fwd};
-        return;
-      }
-      if (e.hash == h && e.count == k && e.rings == ring_count &&
-          std::equal(ws_.canon.begin() + e.first, ws_.canon.begin() + e.first + k, ws_.canon.begin() + first)) {
-        ws_.canon.resize(first);
-        if (ws_.dups.empty() || ws_.dups.back().slot != s || ws_.dups.back().face != e.face)
-          ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), e.face, e.fwd});
-        ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), f, fwd});
-        return;
-      }
+    std::uint64_t sum = 0, x = 0;
+    for (std::uint32_t v : r) {
+      const std::uint64_t m = (v + 1) * 0x9E3779B97F4A7C15ULL;
+      sum += m ^ (m >> 29);
+      x ^= m;
     }
+    const std::uint64_t h = mix64(sum ^ (x << 1) ^ (k * 0xC2B2AE3D27D4EB4FULL + ring_count));
+    auto& T = ws_.face_table;
+    for (std::size_t s = h & T.mask;; s = (s + 1) & T.mask) {
+      FaceEntry& e = T.slots[s];
+      if (e.gen != T.gen) {
+        e = FaceEntry{h, f, static_cast<std::uint32_t>(ws_.canon.size()), static_cast<std::uint32_t>(k), ring_count, T.gen};
+        ws_.canon.insert(ws_.canon.end(), r.begin(), r.end());
+        return;
+      }
+      if (e.hash != h || e.count != k || e.rings != ring_count) continue;
+      const int dir = same_cycle(ws_.canon.data() + e.first, r.data(), k);
+      if (dir == 0) continue;
+      if (ws_.dups.empty() || ws_.dups.back().slot != s || ws_.dups.back().face != e.face)
+        ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), e.face, true});
+      ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), f, dir > 0});
+      return;
+    }
+  }
+
+  /// +1 when ring b is ring a from another start, -1 when it is a reversed, 0 otherwise (k >= 3).
+  static int same_cycle(const std::uint32_t* a, const std::uint32_t* b, std::size_t k) {
+    std::size_t j = 0;
+    while (j < k && a[j] != b[0]) ++j;
+    if (j == k) return 0;
+    bool fwd = true, bwd = true;
+    for (std::size_t i = 1; i < k && (fwd || bwd); ++i) {
+      fwd = fwd && b[i] == a[(j + i) % k];
+      bwd = bwd && b[i] == a[(j + k - i) % k];
+    }
+    return fwd ? 1 : bwd ? -1 : 0;
   }
 
   /// Faces written more than once. Copies running opposite ways are a face between two solids of one
@@ -404,112 +536,146 @@ class Decomposer {
 
   void build_faces() {
     tol_ = std::max(p_.weld_tolerance_m, 1e-9);
+    tol2_ = tol_ * tol_;
+    inv_cell_ = 1.0 / (kCell * tol_);
+    const double cos_tol = std::cos(std::clamp(p_.proxy_tolerance_deg, 0.0, 89.0) * kPi / 180.0);
+    cos2_tol_ = cos_tol * cos_tol;
     ws_.weld.assign(m_.vertices.size(), kNone);
     ws_.wpos.clear();
-    ws_.weld_table.assign(pow2_at_least(2 * m_.indices.size() + 16), WeldEntry{0, 0, 0, kNone});
+    const std::size_t distinct = std::min(m_.indices.size(), m_.vertices.size());
+    ws_.weld_table.start(distinct);
+    ws_.exact_table.start(distinct);
     ws_.faces.assign(m_.faces.size(), FaceInfo{});
-    ws_.face_table.assign(pow2_at_least(2 * m_.faces.size() + 16), FaceEntry{0, kNone, 0, 0, 0, false});
+    ws_.face_table.start(m_.faces.size());
     ws_.canon.clear();
     ws_.dups.clear();
     ws_.halfedges.clear();
+    ws_.halfedges.reserve(m_.indices.size());
     const std::size_t nrings = m_.ring_count();
+    V3 n, lo, hi, nh, hlo, hhi;
     for (std::uint32_t f = 0; f < m_.faces.size(); ++f) {
       const MeshFace& mf = m_.faces[f];
       FaceInfo& fi = ws_.faces[f];
       fi.uf = f;
       if (mf.kind == SurfaceKind::FootPrint || mf.kind == SurfaceKind::RoofEdge) continue;
       if (mf.ring_count == 0 || std::size_t(mf.first_ring) + mf.ring_count > nrings) continue;
-      if (!welded_ring(mf.first_ring) || ws_.ring_tmp.size() < 3) continue;
-      const V3 n = newell_tmp();
-      const double len = std::sqrt(dot(n, n));
-      if (!(len > 1e-12)) continue;  // zero area: no orientation, no class
+      if (!welded_ring_normal(mf.first_ring, n, lo, hi) || ws_.ring_tmp.size() < 3) continue;
+      const double len2 = dot(n, n);
+      if (!(len2 > 1e-24)) continue;  // zero area: no orientation, no class
       note_face(f, mf.ring_count);
       fi.n = n;
-      fi.len = len;
-      fi.cls = kWall;  // refined in classify()
+      fi.len = std::sqrt(len2);
+      fi.net = n;
+      fi.c = ws_.wpos[ws_.ring_tmp[0]];
+      fi.lo = lo;
+      fi.hi = hi;
+      // Walls are within the proxy tolerance of vertical either way up; floor or ceiling waits for
+      // the orientation (classify()). Only walls need to know which of their edges they rise from.
+      const bool wall = n.z * n.z < cos2_tol_ * len2;
+      fi.cls = wall ? kWall : kFloor;
       ++stats_->faces_used;
-      add_ring_edges(f, n, len, false);
+      add_ring_edges(f, n, len2, wall, false);
       for (std::uint32_t r = mf.first_ring + 1; r < mf.first_ring + mf.ring_count; ++r) {
-        if (!welded_ring(r) || ws_.ring_tmp.size() < 3) continue;
+        if (!welded_ring_normal(r, nh, hlo, hhi) || ws_.ring_tmp.size() < 3) continue;
         // Holes run against the outer ring so that the face lies on their left; turn those that don't.
-        add_ring_edges(f, n, len, dot(newell_tmp(), n) > 0);
+        const bool same = dot(nh, n) > 0;
+        fi.net = same ? fi.net - nh : V3{fi.net.x + nh.x, fi.net.y + nh.y, fi.net.z + nh.z};
+        add_ring_edges(f, n, len2, wall, same);
       }
     }
     stats_->vertices_welded = ws_.wpos.size();
   }
 
-  void add_ring_edges(std::uint32_t f, const V3& n, double len, bool reverse) {
+  void add_ring_edges(std::uint32_t f, const V3& n, double len2, bool wall, bool reverse) {
     const auto& r = ws_.ring_tmp;
     const std::size_t k = r.size();
     for (std::size_t i = 0; i < k; ++i) {
       std::uint32_t a = r[i], b = r[i + 1 < k ? i + 1 : 0];
       if (reverse) std::swap(a, b);
-      ws_.halfedges.push_back(HalfEdge{a, b, f, rise(n, len, a, b)});
+      ws_.halfedges.push_back(HalfEdge{a, b, f, wall ? rise(n, len2, a, b) : std::int8_t{0}});
     }
   }
 
-  float rise(const V3& n, double len, std::uint32_t a, std::uint32_t b) const {
+  /// HalfEdge::up of a wall facet with Newell normal n (|n|^2 = len2) along a -> b: the sign of
+  /// (n x d).z / (|n| |d|) beyond +-kRise, decided on squares (no square root, no division).
+  std::int8_t rise(const V3& n, double len2, std::uint32_t a, std::uint32_t b) const {
     const V3 d = ws_.wpos[b] - ws_.wpos[a];
-    const double dl = std::sqrt(dot(d, d));
-    if (!(dl > 0)) return 0;
-    return static_cast<float>((n.x * d.y - n.y * d.x) / (len * dl));  // (n x d).z, normalised
+    const double c = n.x * d.y - n.y * d.x;  // (n x d).z
+    if (!(c * c > kRise * kRise * len2 * dot(d, d))) return 0;
+    return c > 0 ? 1 : -1;
   }
 
-  static std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
-    return a < b ? (std::uint64_t(a) << 32 | b) : (std::uint64_t(b) << 32 | a);
-  }
-
+  /// Half-edges grouped by undirected welded edge (open addressing, multiplicative hash), then
+  /// group_members in group order by a counting sort.
   void group_edges() {
     const std::size_t nh = ws_.halfedges.size();
-    ws_.edge_table.assign(pow2_at_least(2 * nh + 16), EdgeEntry{~0ULL, kNone});
-    const std::size_t mask = ws_.edge_table.size() - 1;
+    auto& T = ws_.edge_table;
+    const std::uint32_t gen = T.start(nh);
+    int shift = 64;
+    for (std::size_t m = T.mask; m; m >>= 1) --shift;
+    const std::size_t mask = T.mask;
     ws_.he_group.resize(nh);
-    ws_.group_count.clear();
+    auto& count = ws_.group_count;
+    count.clear();
+    const HalfEdge* H = ws_.halfedges.data();
     for (std::size_t i = 0; i < nh; ++i) {
-      const HalfEdge& h = ws_.halfedges[i];
-      const std::uint64_t key = edge_key(h.a, h.b);
-      std::size_t s = mix64(key) & mask;
-      while (ws_.edge_table[s].group != kNone && ws_.edge_table[s].key != key) s = (s + 1) & mask;
-      EdgeEntry& e = ws_.edge_table[s];
-      if (e.group == kNone) {
-        e.key = key;
-        e.group = static_cast<std::uint32_t>(ws_.group_count.size());
-        ws_.group_count.push_back(0);
+      const std::uint64_t key = H[i].a < H[i].b ? (std::uint64_t(H[i].a) << 32 | H[i].b) : (std::uint64_t(H[i].b) << 32 | H[i].a);
+      std::size_t s = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ULL) >> shift);
+      while (T.slots[s].gen == gen && T.slots[s].key != key) s = (s + 1) & mask;
+      EdgeEntry& e = T.slots[s];
+      if (e.gen != gen) {
+        e = EdgeEntry{key, static_cast<std::uint32_t>(count.size()), gen};
+        count.push_back(0);
       }
       ws_.he_group[i] = e.group;
-      ++ws_.group_count[e.group];
+      ++count[e.group];
     }
-    const std::size_t ng = ws_.group_count.size();
-    ws_.group_start.assign(ng + 1, 0);
-    for (std::size_t g = 0; g < ng; ++g) ws_.group_start[g + 1] = ws_.group_start[g] + ws_.group_count[g];
+    const std::size_t ng = count.size();
+    auto& start = ws_.group_start;
+    start.resize(ng + 1);
+    start[0] = 0;
+    for (std::size_t g = 0; g < ng; ++g) start[g + 1] = start[g] + count[g];
+    auto& cursor = ws_.bucket_start;
+    cursor.assign(start.begin(), start.end() - 1);
     ws_.group_members.resize(nh);
-    for (std::size_t g = 0; g < ng; ++g) ws_.group_count[g] = ws_.group_start[g];  // reuse as cursor
-    for (std::size_t i = 0; i < nh; ++i) ws_.group_members[ws_.group_count[ws_.he_group[i]]++] = static_cast<std::uint32_t>(i);
-    for (std::size_t g = 0; g < ng; ++g) ws_.group_count[g] = ws_.group_start[g + 1] - ws_.group_start[g];
+    for (std::size_t i = 0; i < nh; ++i) ws_.group_members[cursor[ws_.he_group[i]]++] = static_cast<std::uint32_t>(i);
   }
 
   // ---- T-junctions ------------------------------------------------------------------------------
   /// Splits every edge seen by one facet at the ends of other such edges lying on it (within tol).
   /// Returns whether anything was split (then the edges must be regrouped).
   bool split_t_junctions() {
-    auto& ends = ws_.endpoints;
+    auto& ends = ws_.xends;
     ends.clear();
     const std::size_t ng = ws_.group_count.size();
     std::size_t unmatched = 0;
+    const auto& P = ws_.wpos;
     for (std::size_t g = 0; g < ng; ++g) {
       if (ws_.group_count[g] != 1) continue;
       const HalfEdge& h = ws_.halfedges[ws_.group_members[ws_.group_start[g]]];
-      ends.push_back(h.a);
-      ends.push_back(h.b);
+      ends.push_back(XEnd{P[h.a].x, P[h.a].y, P[h.a].z, h.a});
+      ends.push_back(XEnd{P[h.b].x, P[h.b].y, P[h.b].z, h.b});
       ++unmatched;
     }
     if (unmatched < 2) return false;
-    const auto& P = ws_.wpos;
-    std::sort(ends.begin(), ends.end(), [&](std::uint32_t u, std::uint32_t v) {
-      return P[u].x < P[v].x || (P[u].x == P[v].x && u < v);
-    });
-    ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+    std::sort(ends.begin(), ends.end(), [](const XEnd& u, const XEnd& v) { return u.x < v.x || (u.x == v.x && u.v < v.v); });
+    ends.erase(std::unique(ends.begin(), ends.end(), [](const XEnd& u, const XEnd& v) { return u.v == v.v; }), ends.end());
 
+    // Most meshes have none: look first (boxes of the edges against the sorted ends), split after.
+    auto lies_on_some_edge = [&](const HalfEdge& h) {
+      const V3 &A = P[h.a], &B = P[h.b];
+      const double xlo = std::min(A.x, B.x) - tol_, xhi = std::max(A.x, B.x) + tol_;
+      const double ylo = std::min(A.y, B.y) - tol_, yhi = std::max(A.y, B.y) + tol_;
+      const double zlo = std::min(A.z, B.z) - tol_, zhi = std::max(A.z, B.z) + tol_;
+      auto it = std::lower_bound(ends.begin(), ends.end(), xlo, [](const XEnd& u, double x) { return u.x < x; });
+      for (; it != ends.end() && it->x <= xhi; ++it)
+        if (it->y >= ylo && it->y <= yhi && it->z >= zlo && it->z <= zhi && it->v != h.a && it->v != h.b) return true;
+      return false;
+    };
+    bool candidate = false;
+    for (std::size_t g = 0; g < ng && !candidate; ++g)
+      candidate = ws_.group_count[g] == 1 && lies_on_some_edge(ws_.halfedges[ws_.group_members[ws_.group_start[g]]]);
+    if (!candidate) return false;
     auto& out = ws_.split_tmp;
     out.clear();
     bool any = false;
@@ -530,9 +696,9 @@ class Decomposer {
       const double L2 = dot(d, d);
       int nhits = 0;
       const double xlo = std::min(A.x, B.x) - tol_, xhi = std::max(A.x, B.x) + tol_;
-      auto it = std::lower_bound(ends.begin(), ends.end(), xlo, [&](std::uint32_t u, double x) { return P[u].x < x; });
-      for (; it != ends.end() && P[*it].x <= xhi && nhits < 64; ++it) {
-        const std::uint32_t v = *it;
+      auto it = std::lower_bound(ends.begin(), ends.end(), xlo, [](const XEnd& u, double x) { return u.x < x; });
+      for (; it != ends.end() && it->x <= xhi && nhits < 64; ++it) {
+        const std::uint32_t v = it->v;
         if (v == h.a || v == h.b) continue;
         const V3 ap = P[v] - A;
         const double t = dot(ap, d) / L2;
@@ -553,7 +719,7 @@ class Decomposer {
       for (int k = 0; k <= nhits; ++k) {
         const std::uint32_t next = k < nhits ? hits[k].v : h.b;
         if (next == prev) continue;
-        out.push_back(HalfEdge{prev, next, h.face, rise(fi.n, fi.len, prev, next)});
+        out.push_back(HalfEdge{prev, next, h.face, fi.cls == kWall ? rise(fi.n, fi.len * fi.len, prev, next) : std::int8_t{0}});
         prev = next;
       }
     }
@@ -602,36 +768,31 @@ class Decomposer {
       ws_.face_par[f] = par;
     }
     stats_->components = ncomp_;
-    for (const HalfEdge& h : ws_.halfedges) {
-      const std::uint32_t c = ws_.face_comp[h.face];
-      const V3& p = ws_.wpos[h.a];
-      V3& lo = ws_.comp_lo[c];
-      V3& hi = ws_.comp_hi[c];
-      lo.x = std::min(lo.x, p.x), lo.y = std::min(lo.y, p.y), lo.z = std::min(lo.z, p.z);
-      hi.x = std::max(hi.x, p.x), hi.y = std::max(hi.y, p.y), hi.z = std::max(hi.z, p.z);
-    }
+    // Signed volume of each part about its low point org (bounding-box centre in x, y; lowest z):
+    // a planar face's cone from org is (1/6) net . (c - org), net being twice its area vector (its
+    // Newell normal less its holes') and c any point of it. Summed per part with the faces' parities:
+    // (1/6) (sum net.c - (sum net) . org), so one pass over the faces and none over the edges.
     ws_.comp_vol.assign(ncomp_, 0);
     ws_.comp_area.assign(ncomp_, 0);
-    // Signed volume of a planar face's cone from `org`: (1/6) (sum over its boundary edges of a x b) . c
-    // with c any point of its plane (here the start of its first half-edge); holes run the other way
-    // and subtract. Half-edges of one face are contiguous.
-    std::uint32_t cur_face = kNone;
-    V3 c_face, org;
-    double vol = 0;
-    for (const HalfEdge& h : ws_.halfedges) {
-      const std::uint32_t c = ws_.face_comp[h.face];
-      if (h.face != cur_face) {
-        if (cur_face != kNone) ws_.comp_vol[ws_.face_comp[cur_face]] += ws_.face_par[cur_face] ? -vol : vol;
-        vol = 0;
-        cur_face = h.face;
-        org = V3{(ws_.comp_lo[c].x + ws_.comp_hi[c].x) / 2, (ws_.comp_lo[c].y + ws_.comp_hi[c].y) / 2, ws_.comp_lo[c].z};
-        c_face = ws_.wpos[h.a] - org;
-        ws_.comp_area[c] += F[h.face].len / 2;
-      }
-      const V3 a = ws_.wpos[h.a] - org, b = ws_.wpos[h.b] - org;
-      vol += dot(cross(a, b), c_face) / 6.0;
+    ws_.comp_net.assign(ncomp_, V3{});
+    for (std::uint32_t f = 0; f < nf; ++f) {
+      if (F[f].cls == kSkipped) continue;
+      const FaceInfo& fi = F[f];
+      const std::uint32_t c = ws_.face_comp[f];
+      V3& lo = ws_.comp_lo[c];
+      V3& hi = ws_.comp_hi[c];
+      lo.x = std::min(lo.x, fi.lo.x), lo.y = std::min(lo.y, fi.lo.y), lo.z = std::min(lo.z, fi.lo.z);
+      hi.x = std::max(hi.x, fi.hi.x), hi.y = std::max(hi.y, fi.hi.y), hi.z = std::max(hi.z, fi.hi.z);
+      ws_.comp_area[c] += fi.len / 2;
+      const double s = ws_.face_par[f] ? -1.0 : 1.0;
+      ws_.comp_vol[c] += s * dot(fi.net, fi.c);
+      V3& N = ws_.comp_net[c];
+      N.x += s * fi.net.x, N.y += s * fi.net.y, N.z += s * fi.net.z;
     }
-    if (cur_face != kNone) ws_.comp_vol[ws_.face_comp[cur_face]] += ws_.face_par[cur_face] ? -vol : vol;
+    for (std::size_t c = 0; c < ncomp_; ++c) {
+      const V3 org{(ws_.comp_lo[c].x + ws_.comp_hi[c].x) / 2, (ws_.comp_lo[c].y + ws_.comp_hi[c].y) / 2, ws_.comp_lo[c].z};
+      ws_.comp_vol[c] = (ws_.comp_vol[c] - dot(ws_.comp_net[c], org)) / 6;
+    }
     ws_.comp_sign.assign(ncomp_, 0);
     for (std::size_t c = 0; c < ncomp_; ++c) {
       const double scale = std::pow(std::max(ws_.comp_area[c], 1e-12), 1.5);
@@ -649,12 +810,9 @@ class Decomposer {
 
   // ---- 4. decomposition -------------------------------------------------------------------------
   void classify() {
-    const double cos_tol = std::cos(std::clamp(p_.proxy_tolerance_deg, 0.0, 89.0) * kPi / 180.0);
-    for (FaceInfo& fi : ws_.faces) {
-      if (fi.cls == kSkipped) continue;
-      const double nz = fi.sign * fi.n.z / fi.len;
-      fi.cls = nz >= cos_tol ? kCeiling : nz <= -cos_tol ? kFloor : kWall;
-    }
+    // Walls were told at build time; the rest face up (ceiling) or down (floor) once oriented.
+    for (FaceInfo& fi : ws_.faces)
+      if (fi.cls == kFloor || fi.cls == kCeiling) fi.cls = fi.sign * fi.n.z > 0 ? kCeiling : kFloor;
   }
 
   std::uint32_t comp_of(std::uint32_t f) const { return ws_.face_comp[f]; }
@@ -686,7 +844,7 @@ class Decomposer {
         for (std::uint32_t i = 0; i < c; ++i) {
           const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
           const std::uint8_t cls = ws_.faces[h.face].cls;
-          if (cls == kWall && h.up < -kRise) down = true;
+          if (cls == kWall && h.up < 0) down = true;
           if (cls != kFloor) continue;
           if (pass == 0) {
             if (first_floor == kNone) first_floor = h.face;
@@ -784,11 +942,11 @@ class Decomposer {
           break;
         }
         if (fi.cls != kWall) continue;
-        if (h.up < -kRise) {
+        if (h.up < 0) {
           below = true;
           break;
         }
-        if (h.up <= kRise) continue;
+        if (h.up == 0) continue;
         // Outward orientation: the building lies left of the edge seen from above.
         const std::uint32_t from = fi.sign > 0 ? h.a : h.b;
         lo = std::min(h.a, h.b);
