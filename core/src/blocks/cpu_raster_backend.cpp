@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Blocks from pixels (paper §5) on the CPU. Each footprint marks the pixels of its closed bounding
+// Blocks from pixels (paper §5) on the CPU; the CUDA backend (gpu/src/cuda_raster_backend.cu)
+// computes the same blocks with the same functions (blocks/raster_common.h). Each footprint marks the pixels of its closed bounding
 // box. The marking is conservative without any widening: the pixel index floor((x - origin) / res)
 // is a monotone function of x in floating point (subtraction, division by a positive number and
 // floor are all monotone under rounding), and it is the same function for every footprint, so two
@@ -9,10 +10,18 @@
 // pixel are joined (union-find over (pixel, label) pairs sorted by pixel: a sparse raster, so a
 // city needs no whole-city allocation). Bounding boxes are coarser than the footprints' shapes;
 // that only merges some blocks that the union then splits into separate plans.
+//
+// City scale: the keys are made and sorted one band of pixel rows at a time (plan_row_bands: at
+// most band_keys keys per band, 16M = 128 MiB by default), and the union-find on labels, which
+// lives across bands, merges components that cross band edges. Memory is bounded by the band,
+// the labels (O(footprints)) and the grid's own bound of ~64 marks per footprint.
 #include "blocks/cpu_raster_backend.h"
+
+#include "blocks/raster_common.h"
 
 #include <groundplan/error.h>
 
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -98,6 +107,7 @@ struct UnionFind {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   }
+  // the larger root hangs under the smaller: every root is the smallest label of its component
   void join(std::uint32_t a, std::uint32_t b) {
     a = find(a);
     b = find(b);
@@ -105,115 +115,79 @@ struct UnionFind {
   }
 };
 
-inline std::int64_t pix(double v, double origin, double res, std::int64_t n) {
-  return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((v - origin) / res)), 0, n - 1);
-}
-
 }  // namespace
 
 std::vector<Block> CpuRasterBackend::find_blocks(const FootprintSet& fps, const PixelGrid& grid,
                                                  const Progress& progress) {
   const std::size_t n = fps.indices.size();
-  std::vector<Block> blocks;
-  if (n == 0) return blocks;
-  struct Mark {
-    std::uint64_t pixel;
-    std::uint32_t label;
-  };
-  std::vector<std::int64_t> c0(n), c1(n), r0(n), r1(n);
-  std::size_t total = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& b = fps.boxes[i];
-    c0[i] = pix(b.minx, grid.origin_x, grid.resolution_m, grid.width);
-    c1[i] = pix(b.maxx, grid.origin_x, grid.resolution_m, grid.width);
-    r0[i] = pix(b.miny, grid.origin_y, grid.resolution_m, grid.height);
-    r1[i] = pix(b.maxy, grid.origin_y, grid.resolution_m, grid.height);
-    total += static_cast<std::size_t>((c1[i] - c0[i] + 1) * (r1[i] - r0[i] + 1));
-  }
+  if (n == 0) return {};
+  PixelRanges pr;
+  pr.c0.resize(n);
+  pr.c1.resize(n);
+  pr.r0.resize(n);
+  pr.r1.resize(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& rg) {
+    for (std::size_t i = rg.begin(); i < rg.end(); ++i) {
+      const auto& b = fps.boxes[i];
+      pr.c0[i] = pixel_index(b.minx, grid.origin_x, grid.resolution_m, grid.width);
+      pr.c1[i] = pixel_index(b.maxx, grid.origin_x, grid.resolution_m, grid.width);
+      pr.r0[i] = pixel_index(b.miny, grid.origin_y, grid.resolution_m, grid.height);
+      pr.r1[i] = pixel_index(b.maxy, grid.origin_y, grid.resolution_m, grid.height);
+    }
+  });
+  const std::vector<RowBand> bands = plan_row_bands(pr, band_keys_);
   UnionFind uf(n);
-  const std::uint64_t cells = static_cast<std::uint64_t>(grid.width) * static_cast<std::uint64_t>(grid.height);
   const int label_bits = std::max(1, static_cast<int>(std::bit_width(static_cast<std::uint64_t>(n))));
-  if (label_bits + std::bit_width(cells) <= 64) {
-    // (pixel, label) packed in one 64-bit key: sorting plain integers is several times faster
-    std::vector<std::uint64_t> keys;
-    keys.reserve(total);
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::int64_t r = r0[i]; r <= r1[i]; ++r)
-        for (std::int64_t c = c0[i]; c <= c1[i]; ++c)
-          keys.push_back(((static_cast<std::uint64_t>(r) * static_cast<std::uint64_t>(grid.width) +
-                           static_cast<std::uint64_t>(c))
-                          << label_bits) |
-                         i);
-    progress.report(0.3, "rasterised footprints");
-    tbb::parallel_sort(keys.begin(), keys.end());
-    progress.report(0.7, "sorted pixels");
-    const std::uint64_t mask = (std::uint64_t{1} << label_bits) - 1;
-    for (std::size_t k = 1; k < keys.size(); ++k)
-      if ((keys[k] >> label_bits) == (keys[k - 1] >> label_bits))
-        uf.join(static_cast<std::uint32_t>(keys[k] & mask), static_cast<std::uint32_t>(keys[k - 1] & mask));
-  } else {
-    std::vector<Mark> marks;
-    marks.reserve(total);
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::int64_t r = r0[i]; r <= r1[i]; ++r)
-        for (std::int64_t c = c0[i]; c <= c1[i]; ++c)
-          marks.push_back({static_cast<std::uint64_t>(r) * static_cast<std::uint64_t>(grid.width) +
-                               static_cast<std::uint64_t>(c),
-                           static_cast<std::uint32_t>(i)});
-    progress.report(0.3, "rasterised footprints");
-    tbb::parallel_sort(marks.begin(), marks.end(), [](const Mark& a, const Mark& b) { return a.pixel < b.pixel; });
-    progress.report(0.7, "sorted pixels");
-    for (std::size_t k = 1; k < marks.size(); ++k)
-      if (marks[k].pixel == marks[k - 1].pixel) uf.join(marks[k].label, marks[k - 1].label);
-  }
-  std::vector<std::uint32_t> block_of(n, UINT32_MAX);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t root = uf.find(static_cast<std::uint32_t>(i));
-    if (block_of[root] == UINT32_MAX) {
-      block_of[root] = static_cast<std::uint32_t>(blocks.size());
-      blocks.push_back(Block{{}, -1, -1});
+  const std::uint64_t label_mask = (std::uint64_t{1} << label_bits) - 1;
+  std::vector<std::uint64_t> offset(n + 1), keys;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> marks;  // when (pixel, label) does not fit 64 bits
+  const std::uint64_t width = static_cast<std::uint64_t>(grid.width);
+  for (std::size_t bi = 0; bi < bands.size(); ++bi) {
+    const RowBand band = bands[bi];
+    // keys of each footprint inside the band, then their places (exclusive prefix sum)
+    offset[0] = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::int64_t ra = std::max(pr.r0[i], band.row0), rb = std::min(pr.r1[i], band.row1);
+      offset[i + 1] = offset[i] + (ra <= rb ? static_cast<std::uint64_t>((rb - ra + 1) * (pr.c1[i] - pr.c0[i] + 1)) : 0);
     }
-    Block& b = blocks[block_of[root]];
-    b.footprints.push_back(fps.indices[i]);
-    // rightmost pixel (then topmost) of the block is its first seed (paper §5)
-    if (c1[i] > b.seed_col || (c1[i] == b.seed_col && r1[i] > b.seed_row)) {
-      b.seed_col = c1[i];
-      b.seed_row = r1[i];
-    }
-  }
-  return blocks;
-}
-
-namespace {
-
-/// Even-odd test of a pixel centre against one footprint (a hint only: doubles are fine here).
-bool inside_footprint(const Footprint& f, double x, double y) {
-  bool odd = false;
-  for (const Polygon& p : f.polygons) {
-    auto ring = [&](const Ring& r) {
-      for (std::size_t i = 0, n = r.size(); i < n; ++i) {
-        const Point2& a = r[i];
-        const Point2& b = r[(i + 1) % n];
-        if ((a.y > y) != (b.y > y) && x < a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y)) odd = !odd;
-      }
+    const std::uint64_t total = offset[n];
+    const std::uint64_t cells = static_cast<std::uint64_t>(band.row1 - band.row0 + 1) * width;
+    const bool packed = label_bits + std::bit_width(cells) <= 64;
+    auto each_key = [&](auto&& put) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& rg) {
+        for (std::size_t i = rg.begin(); i < rg.end(); ++i) {
+          std::uint64_t k = offset[i];
+          const std::int64_t ra = std::max(pr.r0[i], band.row0), rb = std::min(pr.r1[i], band.row1);
+          for (std::int64_t r = ra; r <= rb; ++r)
+            for (std::int64_t c = pr.c0[i]; c <= pr.c1[i]; ++c)
+              put(k++, static_cast<std::uint64_t>(r - band.row0) * width + static_cast<std::uint64_t>(c),
+                  static_cast<std::uint32_t>(i));
+        }
+      });
     };
-    bool before = odd;
-    odd = false;
-    ring(p.outer);
-    for (const Ring& h : p.holes) ring(h);
-    if (odd) return true;
-    odd = before;
+    if (packed) {
+      // (pixel, label) packed in one 64-bit key: sorting plain integers is several times faster
+      keys.resize(total);
+      each_key([&](std::uint64_t k, std::uint64_t pixel, std::uint32_t label) { keys[k] = (pixel << label_bits) | label; });
+      tbb::parallel_sort(keys.begin(), keys.end());
+      for (std::size_t k = 1; k < keys.size(); ++k)
+        if ((keys[k] >> label_bits) == (keys[k - 1] >> label_bits))
+          uf.join(static_cast<std::uint32_t>(keys[k] & label_mask), static_cast<std::uint32_t>(keys[k - 1] & label_mask));
+    } else {
+      marks.resize(total);
+      each_key([&](std::uint64_t k, std::uint64_t pixel, std::uint32_t label) { marks[k] = {pixel, label}; });
+      tbb::parallel_sort(marks.begin(), marks.end());
+      for (std::size_t k = 1; k < marks.size(); ++k)
+        if (marks[k].first == marks[k - 1].first) uf.join(marks[k].second, marks[k - 1].second);
+    }
+    progress.report(0.9 * static_cast<double>(bi + 1) / static_cast<double>(bands.size()), "joined pixels");
   }
-  return false;
+  keys = {};
+  marks = {};
+  std::vector<std::uint32_t> root(n);
+  for (std::size_t i = 0; i < n; ++i) root[i] = uf.find(static_cast<std::uint32_t>(i));
+  return assemble_blocks(fps, root, pr.c1.data(), pr.r1.data());
 }
-
-bool inside_plan(const GroundPlan& g, double x, double y) {
-  Footprint f;
-  f.polygons.push_back(g.polygon);
-  return inside_footprint(f, x, y);
-}
-
-}  // namespace
 
 Seeds CpuRasterBackend::find_new_seeds(const FootprintSet& fps, const Block& block,
                                        const std::vector<GroundPlan>& so_far, const PixelGrid& grid) {
@@ -221,36 +195,19 @@ Seeds CpuRasterBackend::find_new_seeds(const FootprintSet& fps, const Block& blo
   // -> another outer boundary; inside a plan but covered by no footprint -> a hole. This finds
   // boundaries larger than a pixel; smaller ones are found by the engine's exact check.
   Seeds s;
-  if (block.footprints.empty()) return s;
-  double minx = INFINITY, miny = INFINITY, maxx = -INFINITY, maxy = -INFINITY;
-  for (std::size_t i = 0; i < fps.indices.size(); ++i) {
-    if (!std::binary_search(block.footprints.begin(), block.footprints.end(), fps.indices[i])) continue;
-    minx = std::min(minx, fps.boxes[i].minx);
-    miny = std::min(miny, fps.boxes[i].miny);
-    maxx = std::max(maxx, fps.boxes[i].maxx);
-    maxy = std::max(maxy, fps.boxes[i].maxy);
-  }
-  const std::int64_t cx0 = pix(minx, grid.origin_x, grid.resolution_m, grid.width);
-  const std::int64_t cx1 = pix(maxx, grid.origin_x, grid.resolution_m, grid.width);
-  const std::int64_t cy0 = pix(miny, grid.origin_y, grid.resolution_m, grid.height);
-  const std::int64_t cy1 = pix(maxy, grid.origin_y, grid.resolution_m, grid.height);
-  const auto& fs = *fps.footprints;
-  for (std::int64_t r = cy0; r <= cy1; ++r) {
-    for (std::int64_t c = cx0; c <= cx1; ++c) {
+  const SeedProblem sp = make_seed_problem(fps, block, so_far, grid);
+  const FlatShapes& f = sp.shapes;
+  for (std::int64_t r = sp.r0; r <= sp.r1; ++r) {
+    for (std::int64_t c = sp.c0; c <= sp.c1; ++c) {
       const double x = grid.origin_x + (static_cast<double>(c) + 0.5) * grid.resolution_m;
       const double y = grid.origin_y + (static_cast<double>(r) + 0.5) * grid.resolution_m;
-      bool covered = false;
-      for (std::uint32_t fi : block.footprints)
-        if (inside_footprint(fs[fi], x, y)) {
-          covered = true;
-          break;
-        }
-      bool planned = false;
-      for (const GroundPlan& g : so_far)
-        if (inside_plan(g, x, y)) {
-          planned = true;
-          break;
-        }
+      bool covered = false, planned = false;
+      for (std::uint32_t k = 0; k < sp.n_footprints && !covered; ++k)
+        covered = inside_flat_shape(f.shape_first.data(), f.poly_first.data(), f.ring_first.data(), f.xs.data(),
+                                    f.ys.data(), k, x, y);
+      for (std::uint32_t k = sp.n_footprints; k < f.size() && !planned; ++k)
+        planned = inside_flat_shape(f.shape_first.data(), f.poly_first.data(), f.ring_first.data(), f.xs.data(),
+                                    f.ys.data(), k, x, y);
       if (covered != planned) s.pixels.push_back({c, r});
     }
   }
