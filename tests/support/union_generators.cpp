@@ -41,7 +41,7 @@ struct Xform {
   }
 };
 
-void apply(std::vector<Footprint>& fps, const Xform& t) {
+void apply_xform(std::vector<Footprint>& fps, const Xform& t) {
   for (Footprint& f : fps)
     for (Polygon& p : f.polygons) {
       for (Point2& q : p.outer) q = t(q);
@@ -109,13 +109,13 @@ std::vector<Footprint> generate_case(Family fam, Rng& r) {
         Xform t;
         t.c = m[0];
         t.s = m[1];
-        apply(out, t);
+        apply_xform(out, t);
       } else {
         Xform t;
         const double a = uni(r, 0, 2 * std::numbers::pi);
         t.c = std::cos(a);
         t.s = std::sin(a);
-        apply(out, t);
+        apply_xform(out, t);
       }
       break;
     }
@@ -306,7 +306,7 @@ std::vector<Footprint> synthetic_city(std::size_t n, std::uint64_t seed, bool co
         t.s = std::round(std::sin(a));
         t.cx = 40;
         t.cy = 40;
-        apply(row, t);
+        apply_xform(row, t);
         block.insert(block.end(), row.begin(), row.end());
       }
       // an overlapping wing into the courtyard
@@ -346,7 +346,7 @@ std::vector<Footprint> synthetic_city(std::size_t n, std::uint64_t seed, bool co
     }
     t.tx = bx;
     t.ty = by;
-    apply(block, t);
+    apply_xform(block, t);
     for (Footprint& f : block) {
       if (city.size() >= n) break;
       f.source_id = "b" + std::to_string(city.size());

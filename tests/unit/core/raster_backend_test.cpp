@@ -7,7 +7,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <string>
 
+#include "blocks/cpu_raster_backend.h"
+#include "blocks/raster_common.h"
+#include "union_generators.h"
 #include "union_test_util.h"
 
 namespace groundplan {
@@ -81,9 +86,102 @@ TEST(RasterBackend, NewSeedsFromPixelsFindAHoleAndAMissingOuterRing) {
   EXPECT_TRUE(in_second);
 }
 
-TEST(RasterBackend, CudaIsRefusedUntilIssue4AutoIsCpu) {
-  EXPECT_THROW(make_raster_backend(Device::Cuda), GpuError);
-  EXPECT_STREQ(make_raster_backend(Device::Auto)->name(), "cpu");
+TEST(RasterBackend, CpuIsCpuAutoIsCudaOnlyWithADeviceCudaIsCudaOrAGpuError) {
+  EXPECT_STREQ(make_raster_backend(Device::Cpu)->name(), "cpu");
+  std::unique_ptr<RasterBackend> cuda;
+  try {
+    cuda = make_raster_backend(Device::Cuda);
+  } catch (const GpuError& e) {
+    EXPECT_NE(std::string(e.what()).find("--device cpu"), std::string::npos) << e.what();
+  }
+  if (cuda) {
+    EXPECT_STREQ(cuda->name(), "cuda");
+  }
+  EXPECT_STREQ(make_raster_backend(Device::Auto)->name(), cuda ? "cuda" : "cpu");
+}
+
+// City scale: rows are processed in bands of bounded keys; components crossing band edges are
+// merged through the union-find on labels, so the blocks never depend on the band size.
+TEST(RasterBackend, BandsOfAnySizeGiveTheSameBlocksAndSeeds) {
+  const auto city = testing::synthetic_city(3000, 7);
+  const auto set = make_footprint_set(city);
+  for (double res : {0.0, 0.5, 3.0}) {
+    const auto grid = make_pixel_grid(set, res);
+    detail::CpuRasterBackend whole(std::uint64_t{1} << 40);
+    const auto ref = whole.find_blocks(set, grid, {});
+    for (std::uint64_t band : {1ull, 7ull, 500ull, 20000ull}) {
+      detail::CpuRasterBackend banded(band);
+      const auto got = banded.find_blocks(set, grid, {});
+      ASSERT_EQ(got.size(), ref.size()) << res << " " << band;
+      for (std::size_t i = 0; i < ref.size(); ++i) {
+        EXPECT_EQ(got[i].footprints, ref[i].footprints) << res << " " << band << " block " << i;
+        EXPECT_EQ(got[i].seed_col, ref[i].seed_col);
+        EXPECT_EQ(got[i].seed_row, ref[i].seed_row);
+      }
+    }
+  }
+}
+
+TEST(RasterBackend, BlocksAreOrderedByFirstFootprintAndSeededAtTheirTopRightPixel) {
+  const auto set = make_footprint_set(testing::synthetic_city(2000, 3));
+  const auto grid = make_pixel_grid(set, 0);
+  const auto blocks = make_raster_backend(Device::Cpu)->find_blocks(set, grid, {});
+  std::vector<int> seen(set.indices.size(), 0);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    ASSERT_FALSE(blocks[b].footprints.empty());
+    EXPECT_TRUE(std::is_sorted(blocks[b].footprints.begin(), blocks[b].footprints.end()));
+    if (b) {
+      EXPECT_LT(blocks[b - 1].footprints.front(), blocks[b].footprints.front());
+    }
+    std::int64_t col = -1, row = -1;
+    for (auto f : blocks[b].footprints) {
+      ++seen[f];
+      const auto& box = set.boxes[f];  // synthetic_city footprints are all usable: index == position
+      const std::int64_t c = detail::pixel_index(box.maxx, grid.origin_x, grid.resolution_m, grid.width);
+      const std::int64_t r = detail::pixel_index(box.maxy, grid.origin_y, grid.resolution_m, grid.height);
+      if (c > col || (c == col && r > row)) col = c, row = r;
+    }
+    EXPECT_EQ(blocks[b].seed_col, col);
+    EXPECT_EQ(blocks[b].seed_row, row);
+  }
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int k) { return k == 1; }));
+}
+
+TEST(RasterBackend, RowBandsCoverEveryRowOnceWithinTheBudget) {
+  detail::PixelRanges pr;
+  auto add = [&](std::int64_t c0, std::int64_t c1, std::int64_t r0, std::int64_t r1) {
+    pr.c0.push_back(c0), pr.c1.push_back(c1), pr.r0.push_back(r0), pr.r1.push_back(r1);
+  };
+  add(0, 9, 0, 4);      // 10 keys a row
+  add(0, 99, 3, 3);     // one row of 100 keys (over a budget of 30)
+  add(5, 5, 20, 40);    // after a gap of empty rows
+  add(0, 2, 10, 12);
+  for (std::uint64_t budget : {1ull, 30ull, 1000ull}) {
+    const auto bands = detail::plan_row_bands(pr, budget);
+    ASSERT_FALSE(bands.empty());
+    EXPECT_EQ(bands.front().row0, 0);
+    EXPECT_EQ(bands.back().row1, 40);
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+      EXPECT_LE(bands[b].row0, bands[b].row1);
+      if (b) {
+        EXPECT_EQ(bands[b].row0, bands[b - 1].row1 + 1);
+      }
+      std::uint64_t keys = 0;
+      int rows_with_keys = 0;
+      for (std::int64_t r = bands[b].row0; r <= bands[b].row1; ++r) {
+        std::uint64_t row_keys = 0;
+        for (std::size_t i = 0; i < pr.c0.size(); ++i)
+          if (pr.r0[i] <= r && r <= pr.r1[i]) row_keys += static_cast<std::uint64_t>(pr.c1[i] - pr.c0[i] + 1);
+        keys += row_keys;
+        rows_with_keys += row_keys > 0;
+      }
+      // over the budget only as a single row with keys (empty rows cost nothing)
+      if (keys > budget) {
+        EXPECT_EQ(rows_with_keys, 1) << budget << " band " << b;
+      }
+    }
+  }
+  EXPECT_EQ(detail::plan_row_bands(pr, 1000).size(), 1u);
 }
 
 }  // namespace
