@@ -101,6 +101,9 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
   // One working CRS for all inputs: the first file decides it (or -t_srs does); later files are
   // transformed into it.
   std::string working_definition = options.t_srs;
+  // A file without CRS keeps its coordinates as written; after that, no georeferenced file can join
+  // it (and before it, none can: WorkingFrame refuses an unknown source once a target is set).
+  std::string unknown_frame_file;
   std::size_t files_failed = 0;
   std::string first_failure;
 
@@ -127,6 +130,11 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
           crs.target_srs = working_definition;
           frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
         }
+        const bool georeferenced = info.in_working_crs || (frame && frame->source_known());
+        if (georeferenced && !unknown_frame_file.empty())
+          throw InvalidArgument(file + ": has a CRS, but " + unknown_frame_file +
+                                " (read before it) has none, so their coordinates cannot be combined; give every "
+                                "input a CRS, or process them separately");
         placed = !frame || frame->transform(mesh, &reason);
       } catch (const Error& e) {
         // The file's CRS cannot hold this building (EPSG:4326 on metres ...): the file's fault, so the
@@ -183,15 +191,18 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     result.buildings_dropped += given_up.size();
     if (info.in_working_crs) {
       for (const std::string& note : info.notes) result.problems.push_back({"", file, "georeference", "NOTE", note});
-      if (result.crs_wkt.empty() && info.working_crs.known) {
+      if (result.crs_wkt.empty() && info.working_crs.known && unknown_frame_file.empty()) {
         result.crs_wkt = info.working_crs.wkt;
         result.crs_name = info.working_crs.epsg ? "EPSG:" + std::to_string(info.working_crs.epsg) : info.working_crs.name;
         if (working_definition.empty()) working_definition = info.working_crs.definition;
       }
     }
+    if (frame && !frame->source_known() && !delivered.empty() && working_definition.empty() &&
+        unknown_frame_file.empty())
+      unknown_frame_file = file;
     if (frame) {
       for (const std::string& note : frame->notes()) result.problems.push_back({"", file, "georeference", "NOTE", note});
-      if (result.crs_wkt.empty() && frame->working_crs().known) {
+      if (result.crs_wkt.empty() && frame->working_crs().known && unknown_frame_file.empty()) {
         result.crs_wkt = frame->working_crs().wkt;
         result.crs_name = frame->working_crs().epsg ? "EPSG:" + std::to_string(frame->working_crs().epsg)
                                                     : frame->working_crs().name;

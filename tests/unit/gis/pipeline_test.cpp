@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <set>
 
 #include "test_support.h"
@@ -92,6 +93,29 @@ TEST(Pipeline, CancelStopsTheWork) {
   int calls = 0;
   const Progress cancel_at_once([&](double, const char*) { return ++calls < 2; });
   EXPECT_THROW(gis::run_pipeline(options, cancel_at_once), Cancelled);
+}
+
+// A folder whose first file has no CRS: its coordinates are kept as written, so a later file with a
+// CRS must not be projected into some UTM zone and mixed with them; it is refused with a problem.
+TEST(Pipeline, FileWithoutCrsIsNotMixedWithGeoreferencedFiles) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "groundplan_mixed_crs_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(test::shared_data("citygml1-berlin-lod2-libcitygml/b1_lod2_s.gml"), dir / "a_no_crs.gml");
+  fs::copy_file(test::sample_data("tum-main-entrance/TUM-Main-Entrance.gml"), dir / "b_utm32.gml");
+  gis::PipelineOptions options;
+  options.inputs = {dir.string()};
+  const gis::PipelineResult r = gis::run_pipeline(options);
+  fs::remove_all(dir);
+  EXPECT_TRUE(r.crs_wkt.empty()) << r.crs_name;
+  bool refused = false;
+  for (const auto& p : r.problems)
+    refused |= p.file.find("b_utm32.gml") != std::string::npos && p.stage == "georeference" &&
+               p.reason.find("a_no_crs.gml") != std::string::npos;
+  EXPECT_TRUE(refused) << "no problem names the mix";
+  for (const auto& f : r.footprints) EXPECT_EQ(f.source_file.find("b_utm32.gml"), std::string::npos) << f.source_id;
+  ASSERT_FALSE(r.footprints.empty());
 }
 
 }  // namespace
