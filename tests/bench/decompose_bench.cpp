@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "test_config.h"
+#include "test_support.h"
 
 namespace {
 
@@ -29,21 +30,7 @@ using namespace groundplan;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
-Mesh without_ground(const Mesh& m) {
-  Mesh out;
-  out.source_id = m.source_id;
-  for (const MeshFace& f : m.faces) {
-    if (f.kind == SurfaceKind::Ground) continue;
-    std::vector<std::vector<Point3>> rings;
-    for (std::uint32_t r = f.first_ring; r < f.first_ring + f.ring_count; ++r) {
-      std::vector<Point3> ring;
-      for (std::uint32_t k = m.ring_offsets[r]; k < m.ring_offsets[r + 1]; ++k) ring.push_back(m.vertices[m.indices[k]]);
-      rings.push_back(std::move(ring));
-    }
-    out.add_face(rings, f.kind, f.lod);
-  }
-  return out;
-}
+using test::without_ground;
 
 /// Median seconds of one pass of f over ~0.5 s of passes (at least 5).
 template <class F>

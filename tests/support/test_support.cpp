@@ -21,4 +21,20 @@ std::vector<Footprint> footprints_from_wkt(const std::vector<std::string>& wkts)
   return out;
 }
 
+Mesh without_ground(const Mesh& m) {
+  Mesh out;
+  out.source_id = m.source_id;
+  for (const MeshFace& f : m.faces) {
+    if (f.kind == SurfaceKind::Ground) continue;
+    std::vector<std::vector<Point3>> rings;
+    for (std::uint32_t r = f.first_ring; r < f.first_ring + f.ring_count; ++r) {
+      std::vector<Point3> ring;
+      for (std::uint32_t k = m.ring_offsets[r]; k < m.ring_offsets[r + 1]; ++k) ring.push_back(m.vertices[m.indices[k]]);
+      rings.push_back(std::move(ring));
+    }
+    out.add_face(rings, f.kind, f.lod);
+  }
+  return out;
+}
+
 }  // namespace groundplan::test

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <proj.h>
 
+#include "read_all.h"
 #include "test_config.h"
 
 #include <unistd.h>
@@ -118,27 +119,8 @@ std::array<double, 3> ecef(double lon_deg, double lat_deg, double h) {
   return {(n + h) * std::cos(lat) * std::cos(lon), (n + h) * std::cos(lat) * std::sin(lon), (n * (1 - e2) + h) * std::sin(lat)};
 }
 
-struct Read {
-  std::vector<Mesh> meshes;
-  std::vector<Problem> problems;
-  ReadInfo info;
-  std::size_t count(const std::string& code) const {
-    std::size_t n = 0;
-    for (const Problem& p : problems) n += p.code == code;
-    return n;
-  }
-  std::string all() const {
-    std::string s;
-    for (const Problem& p : problems) s += p.code + ": " + p.reason + "\n";
-    return s;
-  }
-};
-
-Read read(const std::string& path, const ReadOptions& opt = {}) {
-  Read r;
-  read_any(path, opt, [&](Mesh&& m) { r.meshes.push_back(std::move(m)); }, r.problems, r.info);
-  return r;
-}
+using test::Read;
+using test::read;
 
 /// Mean of the vertices and the z range of a mesh.
 std::array<double, 4> centre(const Mesh& m) {

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <proj.h>
 
+#include "read_all.h"
 #include "test_config.h"
 
 #include <unistd.h>
@@ -142,27 +143,8 @@ Bbox bbox(const Mesh& m) {
   return b;
 }
 
-struct Read {
-  std::vector<Mesh> meshes;
-  std::vector<Problem> problems;
-  ReadInfo info;
-  std::size_t count(const std::string& code) const {
-    std::size_t n = 0;
-    for (const Problem& p : problems) n += p.code == code;
-    return n;
-  }
-  std::string all() const {
-    std::string s;
-    for (const Problem& p : problems) s += p.code + ": " + p.reason + "\n";
-    return s;
-  }
-};
-
-Read read(const std::string& path, const ReadOptions& opt = {}) {
-  Read r;
-  read_any(path, opt, [&](Mesh&& m) { r.meshes.push_back(std::move(m)); }, r.problems, r.info);
-  return r;
-}
+using test::Read;
+using test::read;
 
 // A unit cube, Z_UP metres, x,y in [-0.5, 0.5], z in [0, 1]: 6 quads in one polylist with
 // VERTEX at offset 1 and NORMAL at offset 0 (stride 2), to test offsets.
