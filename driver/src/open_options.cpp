@@ -6,6 +6,7 @@
 #include <cpl_string.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstring>
 
 namespace groundplan::driver {
@@ -27,6 +28,24 @@ const char* open_option_list_xml() {
          "the source CRS when projected, else the UTM zone of the data'/>"
          "  <Option name='ORIGIN' type='string' description='lon,lat[,alt] (degrees, metres) where a glTF without "
          "georeference or a bare COLLADA file sits'/>"
+         "  <Option name='RESOLUTION_MODE' type='string-select' description='EXACT: the resolution only finds "
+         "blocks. RASTER: the paper&apos;s level of detail, holes that hold no whole pixel are filled' default='EXACT'>"
+         "    <Value>EXACT</Value><Value>RASTER</Value>"
+         "  </Option>"
+         "  <Option name='PRESET' type='string-select' description='Level-of-detail preset (CFD: snap 0.01, close "
+         "gaps 0.5, simplify 0.1, min hole area 1, min area 1); options given explicitly override it' default='NONE'>"
+         "    <Value>NONE</Value><Value>CFD</Value>"
+         "  </Option>"
+         "  <Option name='SNAP' type='float' description='Metres: vertices and edges closer than this become shared "
+         "before the union (0 = off)' default='0'/>"
+         "  <Option name='CLOSE_GAPS' type='float' description='Metres: gaps and cavities narrower than this close "
+         "(0 = off)' default='0'/>"
+         "  <Option name='MIN_HOLE_AREA' type='float' description='m2: smaller holes are filled (0 = off)' "
+         "default='0'/>"
+         "  <Option name='MIN_AREA' type='float' description='m2: smaller ground plans are dropped, their buildings "
+         "listed in the problems layer (0 = off)' default='0'/>"
+         "  <Option name='SIMPLIFY' type='float' description='Metres: topology-preserving simplification tolerance "
+         "(0 = off)' default='0'/>"
          "</OpenOptionList>";
 }
 
@@ -70,6 +89,21 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
     o.lod = static_cast<int>(lod);
   }
   if (const char* v = CSLFetchNameValue(open_options, "T_SRS")) o.t_srs = v;
+  if (const char* v = CSLFetchNameValue(open_options, "PRESET")) o.detail = gis::lod_preset(v);
+  if (const char* v = CSLFetchNameValue(open_options, "RESOLUTION_MODE")) o.detail.raster = gis::raster_mode_from_string(v);
+  auto lod_value = [&](const char* name, double* field) {
+    const char* v = CSLFetchNameValue(open_options, name);
+    if (!v) return;
+    const double d = parse_double(name, v);
+    if (!(d >= 0) || !std::isfinite(d))
+      throw InvalidArgument(std::string("open option ") + name + "=" + v + ": must be a number >= 0 (0 = off)");
+    *field = d;
+  };
+  lod_value("SNAP", &o.detail.snap_m);
+  lod_value("CLOSE_GAPS", &o.detail.close_gaps_m);
+  lod_value("MIN_HOLE_AREA", &o.detail.min_hole_area_m2);
+  lod_value("MIN_AREA", &o.detail.min_area_m2);
+  lod_value("SIMPLIFY", &o.detail.simplify_m);
   if (const char* v = CSLFetchNameValue(open_options, "ORIGIN")) o.origin = v;
   return o;
 }

@@ -13,7 +13,8 @@ inline constexpr const char* kPrefix = "GROUNDPLAN:";
 /// The XML GDAL shows in `ogrinfo --format GroundPlan` (GDAL_DMD_OPENOPTIONLIST).
 const char* open_option_list_xml();
 
-/// Reads RESOLUTION, DEVICE, FOOTPRINTS, LOD, T_SRS from a CSL list (char**). Throws InvalidArgument
+/// Reads RESOLUTION, DEVICE, FOOTPRINTS, LOD, T_SRS, ORIGIN and the level-of-detail options (PRESET first,
+/// then RESOLUTION_MODE, SNAP, CLOSE_GAPS, MIN_HOLE_AREA, MIN_AREA, SIMPLIFY override it) from a CSL list (char**). Throws InvalidArgument
 /// naming the option and the bad value.
 gis::PipelineOptions pipeline_options_from(const std::string& connection, char** open_options);
 

@@ -3,6 +3,7 @@
 // The whole job, file(s) in, ground plans out (DESIGN.md stages 1-6). Shared by the OGR driver and the
 // CLI so that both routes give the same plans.
 #include <groundplan/ground_plans.h>
+#include <groundplan/level_of_detail.h>
 #include <groundplan/progress.h>
 #include <groundplan/types.h>
 
@@ -20,10 +21,12 @@ struct PipelineOptions {
   std::string t_srs;                // working CRS as the user names it (EPSG:n, WKT, PROJ string); empty = automatic
   std::string origin;               // "lon,lat[,alt]": where a glTF without georeference or a bare .dae sits; empty = none
   UnionParams union_params;
+  LodParams detail;                 // level of detail for simulation (issue 9); default: the exact union
 };
 
 struct StageTimings {
   double read_s = 0, footprints_s = 0, blocks_s = 0, union_s = 0;  // union_s: boundary evaluation only
+  double lod_s = 0;  // level-of-detail steps (snap, close gaps, simplify, filters)
 };
 
 struct PipelineResult {
@@ -39,6 +42,7 @@ struct PipelineResult {
   std::string crs_wkt;                // working CRS (WKT2), empty when the input has no CRS
   std::string crs_name;               // e.g. "EPSG:25833", for messages
   StageTimings timings;
+  LodStats lod_stats;                 // what the level-of-detail steps changed (all zero when off)
 };
 
 /// Runs read -> footprints -> union. Throws InputError when no input can be read at all (every file
@@ -49,5 +53,11 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
 const char* to_string(FootprintMode mode);
 FootprintMode footprint_mode_from_string(const std::string& s);  // throws InvalidArgument
 Device device_from_string(const std::string& s);                 // throws InvalidArgument
+
+/// Named level-of-detail settings (--preset, PRESET=): "none" (the exact union) or "cfd" (simulation
+/// meshing; docs/level_of_detail.md says why each value). Throws InvalidArgument for other names.
+LodParams lod_preset(const std::string& name);
+/// "exact" (false) or "raster" (true): --resolution-mode, RESOLUTION_MODE=. Throws InvalidArgument.
+bool raster_mode_from_string(const std::string& s);
 
 }  // namespace groundplan::gis
