@@ -220,6 +220,59 @@ std::pair<double, double> segment_distance(const Point2& p, const Point2& a, con
   return {std::hypot(wx - tc * vx, wy - tc * vy), t};
 }
 
+// The ring without the vertices that lie within tol of the chord between their kept neighbours
+// (rounding-scale zigzags and almost-straight vertices), pinned ones excepted; empty when fewer than 3
+// remain. Greedy from a kept anchor: a vertex goes when it and every vertex dropped since the anchor
+// lie within tol of the chord from the anchor to its successor, so the ring moves by at most tol.
+Ring straightened(const Ring& r, const std::vector<char>& pinned, double tol) {
+  const std::size_t n = r.size();
+  if (n < 3) return {};
+  auto is_pinned = [&](std::size_t i) { return !pinned.empty() && pinned[i]; };
+  std::size_t start = n;
+  for (std::size_t i = 0; i < n && start == n; ++i)
+    if (is_pinned(i)) start = i;
+  if (start == n) {  // nothing pinned: start at the sharpest corner, which stays
+    double worst = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double dev = segment_distance(r[i], r[(i + n - 1) % n], r[(i + 1) % n]).first;
+      if (dev > worst) worst = dev, start = i;
+    }
+  }
+  std::vector<char> keep(n, 1);
+  std::size_t anchor = start;
+  for (std::size_t s = 1; s < n; ++s) {
+    const std::size_t k = (start + s) % n, next = (k + 1) % n;
+    bool drop = !is_pinned(k);
+    for (std::size_t j = (anchor + 1) % n; drop && j != next; j = (j + 1) % n)
+      drop = segment_distance(r[j], r[anchor], r[next]).first <= tol;
+    if (drop)
+      keep[k] = 0;
+    else
+      anchor = k;
+  }
+  Ring kept;
+  for (std::size_t s = 0; s < n; ++s)
+    if (keep[(start + s) % n]) kept.push_back(r[(start + s) % n]);
+  if (kept.size() < 3) return {};
+  return kept;
+}
+
+// The polygon that is offset: every ring straightened within tol. An edge a few ulps long (where the
+// engine rounded two crossings next to each other) has a direction that is noise; its strip and
+// its mitre (up to kMitreLimit * d long) would cut a needle into the erosion, which is the exact
+// erosion of that zigzag but not of the wall it rounds. Offsetting the straightened rings instead
+// moves the result by at most about tol. Empty outer ring when nothing of size tol is left.
+Polygon straightened(const Polygon& p, double tol) {
+  Polygon out;
+  out.outer = straightened(without_repeats(p.outer), {}, tol);
+  if (out.outer.empty()) return out;
+  for (const Ring& h : p.holes) {
+    Ring s = straightened(without_repeats(h), {}, tol);
+    if (!s.empty()) out.holes.push_back(std::move(s));
+  }
+  return out;
+}
+
 // One ring of the eroded region, reconciled with the input vertices (see the top of the file).
 Ring reconcile_ring(const Ring& ring, const PointGrid& input, double eps) {
   Ring r = ring;
@@ -245,35 +298,8 @@ Ring reconcile_ring(const Ring& ring, const PointGrid& input, double eps) {
   const std::size_t n = r.size();
   if (n < 3) return {};
 
-  // Straighten: greedy from a kept anchor, a vertex goes when it is not pinned and it and every vertex
-  // already dropped since the anchor lie within eps of the chord from the anchor to its successor, so
-  // the ring moves by at most eps wherever it is changed.
-  std::size_t start = n;
-  for (std::size_t i = 0; i < n && start == n; ++i)
-    if (pinned[i]) start = i;
-  if (start == n) {  // nothing pinned: start at the sharpest corner, which stays
-    double worst = -1;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double dev = segment_distance(r[i], r[(i + n - 1) % n], r[(i + 1) % n]).first;
-      if (dev > worst) worst = dev, start = i;
-    }
-  }
-  std::vector<char> keep(n, 1);
-  std::size_t anchor = start;
-  for (std::size_t s = 1; s < n; ++s) {
-    const std::size_t k = (start + s) % n, next = (k + 1) % n;
-    bool drop = !pinned[k];
-    for (std::size_t j = (anchor + 1) % n; drop && j != next; j = (j + 1) % n)
-      drop = segment_distance(r[j], r[anchor], r[next]).first <= eps;
-    if (drop)
-      keep[k] = 0;
-    else
-      anchor = k;
-  }
-  Ring kept;
-  for (std::size_t s = 0; s < n; ++s)
-    if (keep[(start + s) % n]) kept.push_back(r[(start + s) % n]);
-  if (kept.size() < 3) return {};
+  const Ring kept = straightened(r, pinned, eps);
+  if (kept.empty()) return {};
 
   // Input vertices within eps of an edge join that edge, in order along it.
   Ring out;
@@ -355,7 +381,7 @@ GroupResult close_group(const std::vector<GroundPlan>& plans, const GroundPlan& 
   std::vector<Problem> ignored;  // a footprint of ours without area is a piece we do not need
 
   // M \ erosion(P): the complement of P inside M, the inward strips and the joins at reflex vertices.
-  const Polygon& P = dilated.polygon;
+  const Polygon P = straightened(dilated.polygon, eps);  // at least 2d across: never empty
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
   for (const Point2& p : P.outer) x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
   x0 -= 2 * d, y0 -= 2 * d, x1 += 2 * d, y1 += 2 * d;
@@ -451,7 +477,11 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
   // Dilation: footprint i = plan i with its outward strips and convex joins.
   std::vector<Footprint> grown(plans.size());
   for (std::size_t i = 0; i < plans.size(); ++i) {
-    const Polygon& p = plans[i].polygon;
+    const Polygon p = straightened(plans[i].polygon, eps);
+    if (p.outer.empty()) {  // nothing of size eps: the plan itself, nothing to offset
+      grown[i].polygons.push_back(plans[i].polygon);
+      continue;
+    }
     grown[i].polygons.push_back(p);
     add_offset_pieces(p.outer, d, material_left(p.outer, true) ? +1 : -1, grown[i].polygons);
     for (const Ring& h : p.holes) add_offset_pieces(h, d, material_left(h, false) ? +1 : -1, grown[i].polygons);

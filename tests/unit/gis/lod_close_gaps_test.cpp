@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <iomanip>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -175,6 +177,52 @@ void expect_same_plans(const std::vector<GroundPlan>& a, const std::vector<Groun
 
 constexpr double X0 = 500000.0, Y0 = 5400000.0;  // UTM-like: coordinates with 1e-10 m ulps
 
+// Each known answer is checked in two frames: axis-aligned at UTM coordinates (offsets exact enough
+// that the closing's arithmetic often rounds back onto the input), and rotated by 0.3 rad (every
+// coordinate inexact, walls collinear only up to rounding: what reconciliation is for).
+struct Frame {
+  double angle;
+  Point2 operator()(double x, double y) const {
+    if (angle == 0) return {X0 + x, Y0 + y};
+    return {X0 + std::cos(angle) * x - std::sin(angle) * y, Y0 + std::sin(angle) * x + std::cos(angle) * y};
+  }
+  Polygon operator()(std::initializer_list<Point2> local) const {
+    Polygon p;
+    for (const Point2& q : local) p.outer.push_back((*this)(q.x, q.y));
+    return p;
+  }
+  Ring ring(std::initializer_list<Point2> local) const { return (*this)(local).outer; }
+  Polygon rect(double x0, double y0, double x1, double y1) const { return (*this)({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}); }
+};
+constexpr Frame kFrames[] = {{0.0}, {0.3}};
+
+bool has_vertex(const GroundPlan& g, const Point2& p) {
+  if (std::find(g.polygon.outer.begin(), g.polygon.outer.end(), p) != g.polygon.outer.end()) return true;
+  for (const Ring& h : g.polygon.holes)
+    if (std::find(h.begin(), h.end(), p) != h.end()) return true;
+  return false;
+}
+
+// Walls straight and corners sharp: every vertex of the result is a vertex of the input, the given
+// corners are there and the given (filled) ones are not.
+void expect_input_vertices(const GroundPlan& g, const std::vector<GroundPlan>& in, const std::vector<Point2>& corners,
+                           const std::vector<Point2>& gone) {
+  std::vector<Point2> all;
+  for (const GroundPlan& p : in) {
+    all.insert(all.end(), p.polygon.outer.begin(), p.polygon.outer.end());
+    for (const Ring& h : p.polygon.holes) all.insert(all.end(), h.begin(), h.end());
+  }
+  auto check = [&](const Ring& r) {
+    for (const Point2& v : r)
+      EXPECT_NE(std::find(all.begin(), all.end(), v), all.end())
+          << "new vertex " << std::setprecision(17) << v.x << " " << v.y;
+  };
+  check(g.polygon.outer);
+  for (const Ring& h : g.polygon.holes) check(h);
+  for (const Point2& c : corners) EXPECT_TRUE(has_vertex(g, c)) << "corner lost " << std::setprecision(17) << c.x << " " << c.y;
+  for (const Point2& c : gone) EXPECT_FALSE(has_vertex(g, c)) << "filled corner kept " << std::setprecision(17) << c.x << " " << c.y;
+}
+
 // ---- known answers ----
 
 TEST(LodCloseGaps, RejectsBadWidthAndKeepsEmptyInput) {
@@ -186,119 +234,119 @@ TEST(LodCloseGaps, RejectsBadWidthAndKeepsEmptyInput) {
 }
 
 TEST(LodCloseGaps, TwoRectangles5cmApartBecomeOneRectangle) {
-  const auto in = plans_of({rect(X0, Y0, X0 + 10, Y0 + 5), rect(X0 + 10.05, Y0, X0 + 20, Y0 + 5)});
-  ASSERT_EQ(in.size(), 2u);
-  LodStats st;
-  const auto out = close_gaps(in, 0.1, one_thread(), &st);
-  ASSERT_EQ(out.size(), 1u);
-  // walls straight, corners sharp: exactly the four outer corners of the input
-  EXPECT_EQ(sorted(out[0].polygon.outer), sorted({{X0, Y0}, {X0 + 20, Y0}, {X0 + 20, Y0 + 5}, {X0, Y0 + 5}}));
-  EXPECT_TRUE(out[0].polygon.holes.empty());
-  EXPECT_EQ(out[0].members, (std::vector<std::uint32_t>{0, 1}));
-  EXPECT_EQ(st.close_plans_before, 2u);
-  EXPECT_EQ(st.close_plans_after, 1u);
-  EXPECT_NEAR(st.close_area_added_m2, (10.05 - 10) * 5, 1e-6);
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    const auto in = plans_of({f.rect(0, 0, 10, 5), f.rect(10.05, 0, 20, 5)});
+    ASSERT_EQ(in.size(), 2u);
+    LodStats st;
+    const auto out = close_gaps(in, 0.1, one_thread(), &st);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_TRUE(out[0].polygon.holes.empty());
+    if (f.angle == 0) {  // exactly the four outer corners of the input
+      EXPECT_EQ(sorted(out[0].polygon.outer), sorted({f(0, 0), f(20, 0), f(20, 5), f(0, 5)}));
+    } else {  // the gap's corners are collinear with the walls only up to rounding: they may stay
+      expect_input_vertices(out[0], in, {f(0, 0), f(20, 0), f(20, 5), f(0, 5)}, {});
+    }
+    EXPECT_EQ(out[0].members, (std::vector<std::uint32_t>{0, 1}));
+    EXPECT_EQ(st.close_plans_before, 2u);
+    EXPECT_EQ(st.close_plans_after, 1u);
+    EXPECT_NEAR(st.close_area_added_m2, (10.05 - 10) * 5, 1e-6);
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 TEST(LodCloseGaps, Rectangles15cmApartStayAsTheyWere) {
-  const auto in = plans_of({rect(X0, Y0, X0 + 10, Y0 + 5), rect(X0 + 10.15, Y0, X0 + 20, Y0 + 5)});
-  LodStats st;
-  const auto out = close_gaps(in, 0.1, one_thread(), &st);
-  expect_same_plans(out, in);
-  EXPECT_EQ(st.close_area_added_m2, 0.0);
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    const auto in = plans_of({f.rect(0, 0, 10, 5), f.rect(10.15, 0, 20, 5)});
+    LodStats st;
+    const auto out = close_gaps(in, 0.1, one_thread(), &st);
+    expect_same_plans(out, in);
+    EXPECT_EQ(st.close_area_added_m2, 0.0);
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 TEST(LodCloseGaps, USlotAndNarrowNotchFillWideNotchStays) {
-  // a 10 m square with an 8 cm slot 7 m deep from the top, an 8 cm wide 6 cm deep notch in the bottom
-  // wall and a 1 m wide 6 cm deep notch in the left wall
-  const Polygon u{{{X0, Y0},
-                   {X0 + 3, Y0},
-                   {X0 + 3, Y0 + 0.06},
-                   {X0 + 3.08, Y0 + 0.06},
-                   {X0 + 3.08, Y0},
-                   {X0 + 10, Y0},
-                   {X0 + 10, Y0 + 10},
-                   {X0 + 5.08, Y0 + 10},
-                   {X0 + 5.08, Y0 + 3},
-                   {X0 + 5, Y0 + 3},
-                   {X0 + 5, Y0 + 10},
-                   {X0, Y0 + 10},
-                   {X0, Y0 + 6},
-                   {X0 + 0.06, Y0 + 6},
-                   {X0 + 0.06, Y0 + 5},
-                   {X0, Y0 + 5}},
-                  {}};
-  const auto in = plans_of({u});
-  const auto out = close_gaps(in, 0.1, one_thread());
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(sorted(out[0].polygon.outer), sorted({{X0, Y0},
-                                                  {X0 + 10, Y0},
-                                                  {X0 + 10, Y0 + 10},
-                                                  {X0, Y0 + 10},
-                                                  {X0, Y0 + 6},
-                                                  {X0 + 0.06, Y0 + 6},
-                                                  {X0 + 0.06, Y0 + 5},
-                                                  {X0, Y0 + 5}}));
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    // a 10 m square with an 8 cm slot 7 m deep from the top, an 8 cm wide 6 cm deep notch in the
+    // bottom wall and a 1 m wide 6 cm deep notch in the left wall
+    const auto in = plans_of({f({{0, 0}, {3, 0}, {3, 0.06}, {3.08, 0.06}, {3.08, 0}, {10, 0}, {10, 10}, {5.08, 10}, {5.08, 3},
+                                 {5, 3}, {5, 10}, {0, 10}, {0, 6}, {0.06, 6}, {0.06, 5}, {0, 5}})});
+    const auto out = close_gaps(in, 0.1, one_thread());
+    ASSERT_EQ(out.size(), 1u);
+    const std::vector<Point2> corners{f(0, 0), f(10, 0), f(10, 10), f(0, 10), f(0, 6), f(0.06, 6), f(0.06, 5), f(0, 5)};
+    if (f.angle == 0) EXPECT_EQ(sorted(out[0].polygon.outer), sorted(corners));
+    expect_input_vertices(out[0], in, corners, {f(3, 0.06), f(3.08, 0.06), f(5, 3), f(5.08, 3)});
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 TEST(LodCloseGaps, LShapeAndReflexCornerStayVertexIdentical) {
-  const Polygon l{{{X0, Y0}, {X0 + 12.3, Y0}, {X0 + 12.3, Y0 + 4.1}, {X0 + 4.7, Y0 + 4.1}, {X0 + 4.7, Y0 + 9.9}, {X0, Y0 + 9.9}},
-                  {}};
-  const auto in = plans_of({l, rect(X0 + 6, Y0 + 5, X0 + 9, Y0 + 8)});  // a neighbour 0.9 m away in the corner
-  ASSERT_EQ(in.size(), 2u);
-  const auto out = close_gaps(in, 0.1, one_thread());
-  expect_same_plans(out, in);
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    const auto in = plans_of({f({{0, 0}, {12.3, 0}, {12.3, 4.1}, {4.7, 4.1}, {4.7, 9.9}, {0, 9.9}}),
+                              f.rect(6, 5, 9, 8)});  // a neighbour 0.9 m away in the corner
+    ASSERT_EQ(in.size(), 2u);
+    const auto out = close_gaps(in, 0.1, one_thread());
+    expect_same_plans(out, in);
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 TEST(LodCloseGaps, NarrowCourtyardFilledWideOneKept) {
-  Polygon p = rect(X0, Y0, X0 + 20, Y0 + 20);
-  p.holes.push_back({{X0 + 5, Y0 + 10}, {X0 + 5, Y0 + 10.05}, {X0 + 15, Y0 + 10.05}, {X0 + 15, Y0 + 10}});  // 5 cm
-  p.holes.push_back({{X0 + 5, Y0 + 5}, {X0 + 5, Y0 + 6}, {X0 + 6, Y0 + 6}, {X0 + 6, Y0 + 5}});              // 1 m
-  const auto in = plans_of({p});
-  ASSERT_EQ(in.size(), 1u);
-  ASSERT_EQ(in[0].polygon.holes.size(), 2u);
-  const auto out = close_gaps(in, 0.1, one_thread());
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].polygon.outer, in[0].polygon.outer);
-  ASSERT_EQ(out[0].polygon.holes.size(), 1u);
-  EXPECT_EQ(sorted(out[0].polygon.holes[0]), sorted({{X0 + 5, Y0 + 5}, {X0 + 5, Y0 + 6}, {X0 + 6, Y0 + 6}, {X0 + 6, Y0 + 5}}));
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    Polygon p = f.rect(0, 0, 20, 20);
+    p.holes.push_back(f.ring({{5, 10}, {5, 10.05}, {15, 10.05}, {15, 10}}));  // 5 cm
+    p.holes.push_back(f.ring({{5, 5}, {5, 6}, {6, 6}, {6, 5}}));              // 1 m
+    const auto in = plans_of({p});
+    ASSERT_EQ(in.size(), 1u);
+    ASSERT_EQ(in[0].polygon.holes.size(), 2u);
+    const auto out = close_gaps(in, 0.1, one_thread());
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].polygon.outer, in[0].polygon.outer);
+    ASSERT_EQ(out[0].polygon.holes.size(), 1u);
+    EXPECT_EQ(sorted(out[0].polygon.holes[0]), sorted(f.ring({{5, 5}, {5, 6}, {6, 6}, {6, 5}})));
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 TEST(LodCloseGaps, WedgeGapClosesOnlyWhereNarrowerThanD) {
-  // the gap widens from 2 cm at y = 0 to 30 cm at y = 10: narrower than 10 cm below y ~ 2.86
-  const Polygon a = rect(X0, Y0, X0 + 10, Y0 + 10);
-  const Polygon b{{{X0 + 10.02, Y0}, {X0 + 20, Y0}, {X0 + 20, Y0 + 10}, {X0 + 10.3, Y0 + 10}}, {}};
-  const auto in = plans_of({a, b});
-  ASSERT_EQ(in.size(), 2u);
-  const auto out = close_gaps(in, 0.1, one_thread());
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_TRUE(inside(out, {X0 + 10.01, Y0 + 0.5}));
-  EXPECT_TRUE(inside(out, {X0 + 10.02, Y0 + 2.0}));   // gap 7.6 cm
-  EXPECT_FALSE(inside(out, {X0 + 10.05, Y0 + 4.0}));  // gap 13.2 cm
-  EXPECT_FALSE(inside(out, {X0 + 10.1, Y0 + 9.0}));
-  // the input's corners are still corners of the result
-  for (const Point2& c : {Point2{X0, Y0}, Point2{X0 + 20, Y0}, Point2{X0 + 20, Y0 + 10}, Point2{X0 + 10.3, Y0 + 10},
-                          Point2{X0 + 10, Y0 + 10}, Point2{X0, Y0 + 10}})
-    EXPECT_NE(std::find(out[0].polygon.outer.begin(), out[0].polygon.outer.end(), c), out[0].polygon.outer.end())
-        << c.x - X0 << " " << c.y - Y0;
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    // the gap widens from 2 cm at y = 0 to 30 cm at y = 10: narrower than 10 cm below y ~ 2.86
+    const auto in = plans_of({f.rect(0, 0, 10, 10), f({{10.02, 0}, {20, 0}, {20, 10}, {10.3, 10}})});
+    ASSERT_EQ(in.size(), 2u);
+    const auto out = close_gaps(in, 0.1, one_thread());
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_TRUE(inside(out, f(10.01, 0.5)));
+    EXPECT_TRUE(inside(out, f(10.02, 2.0)));   // gap 7.6 cm
+    EXPECT_FALSE(inside(out, f(10.05, 4.0)));  // gap 13.2 cm
+    EXPECT_FALSE(inside(out, f(10.1, 9.0)));
+    // the input's corners are still corners of the result, the gap's bottom ones are gone
+    for (const Point2& c : {f(0, 0), f(20, 0), f(20, 10), f(10.3, 10), f(10, 10), f(0, 10)})
+      EXPECT_TRUE(has_vertex(out[0], c)) << c.x - X0 << " " << c.y - Y0;
+    if (f.angle == 0) {  // rotated, they are collinear with the bottom wall only up to rounding and may stay
+      EXPECT_FALSE(has_vertex(out[0], f(10, 0)));
+      EXPECT_FALSE(has_vertex(out[0], f(10.02, 0)));
+    }
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 TEST(LodCloseGaps, SharpSpikeKeepsItsTip) {
-  // a 4-degree spike: its mitre is clipped at the limit, and the closing gives it back whole
-  const double tip = 20 * std::tan(2.0 * M_PI / 180);
-  const Polygon s{{{X0, Y0}, {X0 + 20, Y0 + tip}, {X0, Y0 + 2 * tip}}, {}};
-  const auto in = plans_of({s, rect(X0 - 5, Y0 - 1, X0 - 0.05, Y0 + 3)});
-  const auto out = close_gaps(in, 0.1, one_thread());
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_NE(std::find(out[0].polygon.outer.begin(), out[0].polygon.outer.end(), Point2{X0 + 20, Y0 + tip}),
-            out[0].polygon.outer.end());
-  check_against_geos(in, out, 0.1);
+  for (const Frame& f : kFrames) {
+    SCOPED_TRACE(f.angle);
+    // a 4-degree spike: its mitre is clipped at the limit, and the closing gives it back whole
+    const double tip = 20 * std::tan(2.0 * M_PI / 180);
+    const auto in = plans_of({f({{0, 0}, {20, tip}, {0, 2 * tip}}), f.rect(-5, -1, -0.05, 3)});
+    const auto out = close_gaps(in, 0.1, one_thread());
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_TRUE(has_vertex(out[0], f(20, tip)));
+    check_against_geos(in, out, 0.1);
+  }
 }
 
 // ---- random rows of rectangles, axis-aligned and rotated, gaps in [0, 2D] ----
