@@ -36,6 +36,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -474,24 +475,70 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
   const double ulp = std::nextafter(coord + width_m, std::numeric_limits<double>::infinity()) - (coord + width_m);
   const double eps = std::max({1e-7, 64 * ulp, 1e-5 * width_m});
 
-  // Dilation: footprint i = plan i with its outward strips and convex joins.
-  std::vector<Footprint> grown(plans.size());
+  // A convex plan without holes that nothing comes near is its own closing (the mitre offsets of a
+  // convex polygon out and back in give it back; a clipped mitre reaches less than (L + 1) d): it
+  // passes through untouched and takes no part in the unions. Isolation: boxes grown by that reach,
+  // swept along x.
+  const double reach = (kMitreLimit + 1) * d;
+  std::vector<std::array<double, 4>> box(plans.size());
   for (std::size_t i = 0; i < plans.size(); ++i) {
-    const Polygon p = straightened(plans[i].polygon, eps);
-    if (p.outer.empty()) {  // nothing of size eps: the plan itself, nothing to offset
-      grown[i].polygons.push_back(plans[i].polygon);
+    auto& b = box[i];
+    b = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+         -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    for (const Point2& p : plans[i].polygon.outer)
+      b = {std::min(b[0], p.x - reach), std::min(b[1], p.y - reach), std::max(b[2], p.x + reach), std::max(b[3], p.y + reach)};
+  }
+  std::vector<char> near(plans.size(), 0);
+  {
+    std::vector<std::size_t> by_x(plans.size());
+    for (std::size_t i = 0; i < by_x.size(); ++i) by_x[i] = i;
+    std::sort(by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) { return box[a][0] < box[b][0]; });
+    for (std::size_t a = 0; a < by_x.size(); ++a)
+      for (std::size_t b = a + 1; b < by_x.size() && box[by_x[b]][0] <= box[by_x[a]][2]; ++b) {
+        const auto &p = box[by_x[a]], &q = box[by_x[b]];
+        if (p[1] <= q[3] && q[1] <= p[3]) near[by_x[a]] = near[by_x[b]] = 1;
+      }
+  }
+  auto convex = [](const Polygon& p) {
+    if (!p.holes.empty()) return false;
+    const Ring r = without_repeats(p.outer);
+    const int side = material_left(r, true) ? +1 : -1;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const Point2 &a = r[(i + r.size() - 1) % r.size()], &b = r[i], &c = r[(i + 1) % r.size()];
+      const int turn = robust::orient(a, b, c);
+      if (turn == -side || (turn == 0 && (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y) < 0)) return false;
+    }
+    return r.size() >= 3;
+  };
+
+  // Dilation: one footprint per remaining plan, the plan with its outward strips and convex joins.
+  std::vector<std::pair<std::uint32_t, GroundPlan>> tagged;  // (first input plan inside, plan)
+  std::vector<Footprint> grown;
+  std::vector<std::uint32_t> grown_plan;  // footprint -> input plan
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    if (!near[i] && convex(plans[i].polygon)) {
+      tagged.emplace_back(static_cast<std::uint32_t>(i), plans[i]);
       continue;
     }
-    grown[i].polygons.push_back(p);
-    add_offset_pieces(p.outer, d, material_left(p.outer, true) ? +1 : -1, grown[i].polygons);
-    for (const Ring& h : p.holes) add_offset_pieces(h, d, material_left(h, false) ? +1 : -1, grown[i].polygons);
+    grown_plan.push_back(static_cast<std::uint32_t>(i));
+    Footprint& f = grown.emplace_back();
+    const Polygon p = straightened(plans[i].polygon, eps);
+    if (p.outer.empty()) {  // nothing of size eps: the plan itself, nothing to offset
+      f.polygons.push_back(plans[i].polygon);
+      continue;
+    }
+    f.polygons.push_back(p);
+    add_offset_pieces(p.outer, d, material_left(p.outer, true) ? +1 : -1, f.polygons);
+    for (const Ring& h : p.holes) add_offset_pieces(h, d, material_left(h, false) ? +1 : -1, f.polygons);
   }
   UnionParams dilate_params = union_params;
   dilate_params.stats = nullptr;
   std::vector<Problem> ignored;
-  const std::vector<GroundPlan> dilated = build_ground_plans(grown, dilate_params, ignored);
+  std::vector<GroundPlan> dilated = build_ground_plans(grown, dilate_params, ignored);
   grown.clear();
   grown.shrink_to_fit();
+  for (GroundPlan& g : dilated)
+    for (std::uint32_t& m : g.members) m = grown_plan[m];  // ascending still: grown_plan is
 
   // Erode and reconcile each dilated plan on its own, the largest first.
   std::vector<GroupResult> results(dilated.size());
@@ -515,7 +562,6 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
   }
 
   // Output in the order of the input plans (by the first input plan each result contains).
-  std::vector<std::pair<std::uint32_t, GroundPlan>> tagged;
   for (GroupResult& r : results)
     for (std::size_t j = 0; j < r.plans.size(); ++j) tagged.emplace_back(r.first_input[j], std::move(r.plans[j]));
   std::stable_sort(tagged.begin(), tagged.end(), [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -404,7 +404,7 @@ TEST(LodCloseGaps, RandomRowsMatchGeos) {
 }
 
 TEST(LodCloseGaps, SyntheticCityBlocksAgreeWithGeos) {
-  const auto fps = testing::synthetic_city(300, 7);
+  const auto fps = testing::synthetic_city(2000, 7);
   std::vector<Problem> problems;
   const auto in = build_ground_plans(fps, one_thread(), problems);
   LodStats st;
