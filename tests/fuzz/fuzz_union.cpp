@@ -11,6 +11,7 @@
 // touching; a fine grid at a large offset; half-integers), then per footprint one byte of vertex count
 // and a hole flag, and two bytes per vertex.
 #include "fuzz_entry.h"
+#include "fuzz_polygons.h"
 
 #include <groundplan/error.h>
 #include <groundplan/gis/geos_reference.h>
@@ -25,22 +26,6 @@
 #include <vector>
 
 namespace {
-
-struct Decoder {
-  const std::uint8_t* p;
-  const std::uint8_t* end;
-  bool more() const { return p < end; }
-  std::uint8_t byte() { return p < end ? *p++ : 0; }
-};
-
-double coord(std::uint8_t v, int mode, bool is_x) {
-  switch (mode) {
-    case 0: return static_cast<double>(v % 16);                             // tiny grid: degeneracies
-    case 1: return (is_x ? 500000.0 : 5400000.0) + static_cast<double>(v) * 0.125;  // offset, dyadic
-    case 2: return static_cast<double>(v) * 0.5;
-    default: return static_cast<double>(v) / 7.0;                           // inexact
-  }
-}
 
 bool polygon_valid_geos(GEOSContextHandle_t h, const groundplan::Polygon& poly) {
   auto ring = [&](const groundplan::Ring& r) -> GEOSGeometry* {
@@ -65,29 +50,7 @@ bool polygon_valid_geos(GEOSContextHandle_t h, const groundplan::Polygon& poly) 
 
 GROUNDPLAN_FUZZ_TARGET(union) {
   using namespace groundplan;
-  Decoder d{data, data + size};
-  const int mode = d.byte() % 4;
-  std::vector<Footprint> fps;
-  while (d.more() && fps.size() < 12) {
-    const std::uint8_t head = d.byte();
-    const std::size_t n = 3 + head % 14;
-    const bool with_hole = head & 0x80;
-    Footprint f;
-    f.source_id = "f" + std::to_string(fps.size());
-    Polygon poly;
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint8_t x = d.byte(), y = d.byte();
-      poly.outer.push_back({coord(x, mode, true), coord(y, mode, false)});
-    }
-    if (with_hole)
-      for (std::size_t i = 0; i < 3 + (head >> 4) % 4; ++i) {
-        const std::uint8_t x = d.byte(), y = d.byte();
-        if (poly.holes.empty()) poly.holes.emplace_back();
-        poly.holes.back().push_back({coord(x, mode, true), coord(y, mode, false)});
-      }
-    f.polygons.push_back(std::move(poly));
-    fps.push_back(std::move(f));
-  }
+  std::vector<Footprint> fps = fuzz::decode_footprints(data, size);
   if (fps.empty()) return 0;
 
   std::vector<Problem> problems;

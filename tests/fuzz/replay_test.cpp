@@ -17,6 +17,7 @@ int groundplan_fuzz_srs_name(const std::uint8_t*, std::size_t);
 int groundplan_fuzz_coordinates(const std::uint8_t*, std::size_t);
 int groundplan_fuzz_union(const std::uint8_t*, std::size_t);
 int groundplan_fuzz_read_any(const std::uint8_t*, std::size_t);
+int groundplan_fuzz_lod(const std::uint8_t*, std::size_t);
 
 namespace {
 
@@ -42,12 +43,13 @@ TEST(FuzzRegressions, SrsName) { replay("srs_name", groundplan_fuzz_srs_name); }
 TEST(FuzzRegressions, Coordinates) { replay("coordinates", groundplan_fuzz_coordinates); }
 TEST(FuzzRegressions, Union) { replay("union", groundplan_fuzz_union); }
 TEST(FuzzRegressions, ReadAny) { replay("read_any", groundplan_fuzz_read_any); }
+TEST(FuzzRegressions, Lod) { replay("lod", groundplan_fuzz_lod); }
 
 /// The bodies also take the empty input and a few bytes (the smallest cases libFuzzer starts with).
 TEST(FuzzRegressions, TinyInputs) {
   const std::uint8_t bytes[] = {0, 1, 2, 3, 0xff, '<', 'a', '>'};
   for (auto body : {groundplan_fuzz_citygml, groundplan_fuzz_srs_name, groundplan_fuzz_coordinates,
-                    groundplan_fuzz_union, groundplan_fuzz_read_any})
+                    groundplan_fuzz_union, groundplan_fuzz_read_any, groundplan_fuzz_lod})
     for (std::size_t n = 0; n <= sizeof bytes; ++n) EXPECT_NO_THROW(body(bytes, n));
 }
 

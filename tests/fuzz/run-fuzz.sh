@@ -26,6 +26,9 @@ seed() {  # seed TARGET: fills $work/TARGET/seeds
         awk -v d="$d" '{ f = d "/s" NR; printf "%s", $0 > f; close(f) }' ;;
     coordinates)
       printf ', .1 2 3 4 5 6' > "$d/a"; printf ';:,1,5:2,5;3,5:4,5' > "$d/b" ;;
+    lod)
+      head -c 64 /dev/urandom > "$d/r1"
+      printf '\x2b\x03\x00\x03\x00\x00\x0a\x00\x0a\x0a\x03\x0a\x00\x0b\x00\x0b\x0a\x03\x05\x05\x0f\x05\x0f\x0f' > "$d/grid" ;;
     union)
       head -c 64 /dev/urandom > "$d/r1"; printf '\x00\x03\x00\x00\x0a\x00\x0a\x0a\x03\x05\x05\x0f\x05\x0f\x0f' > "$d/grid" ;;
     read_any)
@@ -39,7 +42,7 @@ seed() {  # seed TARGET: fills $work/TARGET/seeds
 }
 
 status=0
-for t in citygml srs_name coordinates union read_any; do
+for t in citygml srs_name coordinates union read_any lod; do
   exe=$build/bin/fuzz_$t
   [ -x "$exe" ] || { echo "run-fuzz: $exe missing (build with -DGROUNDPLAN_FUZZ=ON)"; exit 2; }
   seed $t
