@@ -273,6 +273,10 @@ int run(int argc, char** argv) {
   app.add_option("--device", device, "auto|cpu|cuda: where blocks are rasterised");
   app.add_option("--footprints", footprints, "auto|ground-surface|decompose: where footprints come from");
   app.add_option("--origin", origin, "lon,lat[,alt] where a glTF without georeference or a bare .dae sits");
+  std::string axis_order = "auto";
+  app.add_option("--axis-order", axis_order,
+                 "auto|east-north|north-east: CityGML axis order when a file breaks its CRS's rule (e.g. EPSG:4979 "
+                 "written lon,lat); auto follows the CRS");
   app.add_option("--lod", lod, "Level of detail to read (-1 = highest per building)")->check(CLI::Range(-1, 4));
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
@@ -332,6 +336,7 @@ int run(int argc, char** argv) {
   options.footprints = groundplan::gis::footprint_mode_from_string(footprints);
   options.lod = lod;
   options.origin = origin;
+  options.source_axis = groundplan::gis::axis_order_from_string(axis_order);
   options.detail = groundplan::gis::lod_preset(o_preset->count() ? preset : "none");
   if (o_mode->count()) options.detail.raster = groundplan::gis::raster_mode_from_string(resolution_mode);
   if (o_snap->count()) options.detail.snap_m = lod_flags.snap_m;

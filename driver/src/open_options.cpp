@@ -28,6 +28,10 @@ const char* open_option_list_xml() {
          "the source CRS when projected, else the UTM zone of the data'/>"
          "  <Option name='ORIGIN' type='string' description='lon,lat[,alt] (degrees, metres) where a glTF without "
          "georeference or a bare COLLADA file sits'/>"
+         "  <Option name='AXIS_ORDER' type='string-select' description='CityGML axis order when a file breaks its "
+         "CRS&apos;s rule (EPSG:4979 written lon,lat): AUTO follows the CRS' default='AUTO'>"
+         "    <Value>AUTO</Value><Value>EAST-NORTH</Value><Value>NORTH-EAST</Value>"
+         "  </Option>"
          "  <Option name='RESOLUTION_MODE' type='string-select' description='EXACT: the resolution only finds "
          "blocks. RASTER: the paper&apos;s level of detail, holes that hold no whole pixel are filled' default='EXACT'>"
          "    <Value>EXACT</Value><Value>RASTER</Value>"
@@ -105,6 +109,7 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
   lod_value("MIN_AREA", &o.detail.min_area_m2);
   lod_value("SIMPLIFY", &o.detail.simplify_m);
   if (const char* v = CSLFetchNameValue(open_options, "ORIGIN")) o.origin = v;
+  if (const char* v = CSLFetchNameValue(open_options, "AXIS_ORDER")) o.source_axis = gis::axis_order_from_string(v);
   return o;
 }
 

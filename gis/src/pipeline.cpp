@@ -104,6 +104,14 @@ LodParams lod_preset(const std::string& name) {
   throw InvalidArgument("preset: '" + name + "' is not one of none, cfd");
 }
 
+AxisOrder axis_order_from_string(const std::string& s) {
+  const std::string l = lower(s);
+  if (l == "auto") return AxisOrder::Auto;
+  if (l == "east-north" || l == "east_north" || l == "lon-lat" || l == "xy") return AxisOrder::EastNorth;
+  if (l == "north-east" || l == "north_east" || l == "lat-lon" || l == "yx") return AxisOrder::NorthEast;
+  throw InvalidArgument("axis order: '" + s + "' is not one of auto, east-north, north-east");
+}
+
 bool raster_mode_from_string(const std::string& s) {
   const std::string l = lower(s);
   if (l == "exact") return false;
@@ -151,6 +159,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
         if (!info.in_working_crs && !frame) {
           CrsOptions crs;
           crs.target_srs = working_definition;
+          crs.source_axis = options.source_axis;
           frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
         }
         const bool georeferenced = info.in_working_crs || (frame && frame->source_known());

@@ -2,6 +2,7 @@
 #pragma once
 // The whole job, file(s) in, ground plans out (DESIGN.md stages 1-6). Shared by the OGR driver and the
 // CLI so that both routes give the same plans.
+#include <groundplan/gis/crs.h>
 #include <groundplan/ground_plans.h>
 #include <groundplan/level_of_detail.h>
 #include <groundplan/progress.h>
@@ -20,6 +21,8 @@ struct PipelineOptions {
   int lod = -1;                     // -1 = the highest LoD each building has
   std::string t_srs;                // working CRS as the user names it (EPSG:n, WKT, PROJ string); empty = automatic
   std::string origin;               // "lon,lat[,alt]": where a glTF without georeference or a bare .dae sits; empty = none
+  AxisOrder source_axis = AxisOrder::Auto;  // CityGML: axis order of the coordinates when a file breaks its CRS's
+                                            // rule (EPSG:4979 written lon,lat): --axis-order, AXIS_ORDER=
   UnionParams union_params;
   LodParams detail;                 // level of detail for simulation (issue 9); default: the exact union
 };
@@ -57,6 +60,8 @@ Device device_from_string(const std::string& s);                 // throws Inval
 /// Named level-of-detail settings (--preset, PRESET=): "none" (the exact union) or "cfd" (simulation
 /// meshing; docs/level_of_detail.md says why each value). Throws InvalidArgument for other names.
 LodParams lod_preset(const std::string& name);
+/// "auto", "east-north" (x = longitude / easting) or "north-east": --axis-order, AXIS_ORDER=. Throws InvalidArgument.
+AxisOrder axis_order_from_string(const std::string& s);
 /// "exact" (false) or "raster" (true): --resolution-mode, RESOLUTION_MODE=. Throws InvalidArgument.
 bool raster_mode_from_string(const std::string& s);
 
