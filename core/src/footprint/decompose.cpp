@@ -97,7 +97,8 @@ struct DirEdge {
 };
 
 struct ExactEntry {
-  std::uint32_t vertex, rep;  // a mesh vertex with these exact coordinates, its welded id
+  std::uint64_t bx, by, bz;  // the coordinates' bits
+  std::uint32_t rep;         // their welded id
   std::uint32_t gen;
 };
 
@@ -152,6 +153,11 @@ struct XEnd {
   std::uint32_t v;
 };
 
+struct XId {
+  double x;
+  std::uint32_t id;
+};
+
 inline std::uint64_t mix64(std::uint64_t h) {
   h ^= h >> 33;
   h *= 0xff51afd7ed558ccdULL;
@@ -173,13 +179,17 @@ struct Workspace {
   std::vector<V3> wpos;                 // welded positions, relative to the origin
   GenTable<WeldEntry> weld_table;
   GenTable<ExactEntry> exact_table;
+  std::vector<XId> weld_sort;
+  std::vector<std::uint32_t> distinct_of, distinct_weld;  // mesh vertex -> distinct point -> welded id
+  std::vector<V3> distinct_pos;
   std::vector<FaceInfo> faces;
   std::vector<HalfEdge> halfedges, split_tmp;
   GenTable<FaceEntry> face_table;
   std::vector<std::uint32_t> canon;     // canonical welded outer rings, for duplicate faces
   std::vector<Dup> dups;
   std::vector<std::uint32_t> he_group, group_count, group_start, group_members, bucket_start;
-  std::vector<std::uint32_t> ring_tmp;
+  std::vector<std::uint32_t> ring_tmp, ring_buf;
+  std::vector<std::uint32_t> he_next, he_max;  // group_edges(): chains per smaller vertex
   std::vector<V3> comp_lo, comp_hi;
   std::vector<double> comp_vol, comp_area;
   std::vector<V3> comp_net;
@@ -194,6 +204,8 @@ struct Workspace {
   std::uint32_t stamp_gen = 0;
   std::vector<std::uint32_t> endpoints;
   std::vector<XEnd> xends;
+  std::vector<std::uint32_t> open_he, end_seen;  // open_end_on_open_edge()
+  std::uint32_t end_gen = 0;
   std::vector<std::uint32_t> plan_rep;  // plan-view merge of footprint-edge endpoints (rule 2)
   std::vector<std::uint32_t> open_edges;  // footprint edges left in chains that did not close
   std::vector<DirEdge> open_tmp;
@@ -216,7 +228,7 @@ Workspace& workspace() {
   return ws;
 }
 
-std::uint32_t uf_find(std::vector<FaceInfo>& f, std::uint32_t i, std::uint8_t& parity) {
+std::uint32_t uf_find(FaceInfo* f, std::uint32_t i, std::uint8_t& parity) {
   parity = 0;
   std::uint32_t r = i;
   while (f[r].uf != r) {
@@ -293,6 +305,8 @@ class Decomposer {
   V3 o_;
   double tol_ = 1e-3, tol2_ = 1e-6, inv_cell_ = 1, cos2_tol_ = 0;
   static constexpr double kCell = 16;  // weld grid cell, in weld tolerances
+  bool grid_ = false;  // weld through the tolerance grid (vertices within tol of each other)
+  std::size_t ring_len_ = 0;  // vertices in ring_buf
   std::size_t ncomp_ = 0;
   double lower_boundary_len_ = 0;  // plan length of all footprint edges (set when chains stay open)
 
@@ -332,25 +346,98 @@ class Decomposer {
     }
   }
 
-  /// Welded id of mesh vertex vi, kBad for a non-finite one. Grid cells are kCell x tol wide, so a
-  /// point needs the neighbouring cell on an axis only within tol of that side (mostly one probe).
+  /// Welded id of mesh vertex vi, kBad for a non-finite one. Ids are given in order of first use.
+  /// Without vertices within tol of each other (distinct_apart(): nearly always) a vertex is the
+  /// distinct point its coordinates are (found before the pass), and that is all. Otherwise the grid
+  /// welds (weld_vertex_grid). Both give the same ids when no two points lie within tol: the grid
+  /// welds a point only to one within tol (by the same squared distance), so then every distinct
+  /// point is its own vertex, numbered in order of first use.
   std::uint32_t weld_vertex(std::uint32_t vi) {
+    if (!grid_) return weld_apart(vi);
     std::uint32_t& w = ws_.weld[vi];
     if (w != kNone) return w;
+    return w = weld_vertex_grid(vi);
+  }
+
+  /// Hash of a point's coordinate bits.
+  static std::size_t bits_hash(std::uint64_t bx, std::uint64_t by, std::uint64_t bz) {
+    return static_cast<std::size_t>(mix64(bx ^ (by * 0x9E3779B97F4A7C15ULL) ^ (bz * 0xC2B2AE3D27D4EB4FULL)));
+  }
+
+  /// Distinct points of the mesh (bit for bit; non-finite ones kBad) into distinct_of / distinct_pos,
+  /// and whether no two of them lie within tol (then the grid is not needed). Readers give every
+  /// polygon its own copies of shared corners, bit for bit the same: one hash of the raw coordinates
+  /// finds those. Pairs are looked for in x order; those closer than 2 tol in x are measured as
+  /// probe() measures them (|dx| > 2 tol gives a squared distance above tol^2 even rounded). Comparing
+  /// bits finds what comparing values did in the grid: +0/-0 copies differ in bits but lie at
+  /// distance 0 (then the grid welds them), and non-finite points are kBad either way.
+  bool distinct_apart() {
+    const std::size_t nv = m_.vertices.size();
+    auto& X = ws_.exact_table;
+    X.start(nv);
+    auto& of = ws_.distinct_of;
+    auto& pos = ws_.distinct_pos;
+    of.resize(nv);
+    pos.clear();
+    for (std::uint32_t vi = 0; vi < nv; ++vi) {
+      const Point3& q = m_.vertices[vi];
+      if (!(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z))) {
+        of[vi] = kBad;
+        continue;
+      }
+      std::uint64_t bx, by, bz;
+      std::memcpy(&bx, &q.x, 8), std::memcpy(&by, &q.y, 8), std::memcpy(&bz, &q.z, 8);
+      std::size_t es = bits_hash(bx, by, bz) & X.mask;
+      for (;; es = (es + 1) & X.mask) {
+        const ExactEntry& e = X.slots[es];
+        if (e.gen != X.gen) {
+          const std::uint32_t d = static_cast<std::uint32_t>(pos.size());
+          X.slots[es] = ExactEntry{bx, by, bz, d, X.gen};
+          pos.push_back(V3{q.x - o_.x, q.y - o_.y, q.z - o_.z});
+          of[vi] = d;
+          break;
+        }
+        if (e.bx == bx && e.by == by && e.bz == bz) {
+          of[vi] = e.rep;
+          break;
+        }
+      }
+    }
+    ws_.distinct_weld.assign(pos.size(), kNone);
+    const std::size_t n = pos.size();
+    if (n < 2) return true;
+    auto& xs = ws_.weld_sort;
+    xs.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) xs[i] = XId{pos[i].x, i};
+    std::sort(xs.begin(), xs.end(), [](const XId& u, const XId& v) { return u.x < v.x; });
+    const double w = 2 * tol_;
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      const double lim = xs[i].x + w;
+      for (std::size_t j = i + 1; j < n && xs[j].x <= lim; ++j) {
+        const V3 d = pos[xs[j].id] - pos[xs[i].id];
+        if (dot(d, d) <= tol2_) return false;
+      }
+    }
+    return true;
+  }
+
+  /// The grid weld (vertices within tol of each other): exact copies through one hash of the raw
+  /// coordinates, points not seen before through the tolerance grid (weld_new). Grid cells are
+  /// kCell x tol wide, so a point needs the neighbouring cell on an axis only within tol of that
+  /// side (mostly one probe).
+  std::uint32_t weld_vertex_grid(std::uint32_t vi) {
     const Point3& q = m_.vertices[vi];
-    // Readers give every polygon its own copies of shared corners, bit for bit the same: one hash of
-    // the raw coordinates finds those, and only coordinates not seen before go to the grid.
     std::uint64_t bx, by, bz;
     std::memcpy(&bx, &q.x, 8), std::memcpy(&by, &q.y, 8), std::memcpy(&bz, &q.z, 8);
     auto& X = ws_.exact_table;
-    std::size_t es = mix64(bx ^ (by * 0x9E3779B97F4A7C15ULL) ^ (bz * 0xC2B2AE3D27D4EB4FULL)) & X.mask;
+    std::size_t es = bits_hash(bx, by, bz) & X.mask;
     for (;; es = (es + 1) & X.mask) {
       const ExactEntry& e = X.slots[es];
       if (e.gen != X.gen) break;
-      if (m_.vertices[e.vertex] == q) return w = e.rep;
+      if (e.bx == bx && e.by == by && e.bz == bz) return e.rep;
     }
-    w = weld_new(q);
-    X.slots[es] = ExactEntry{vi, w, X.gen};
+    const std::uint32_t w = weld_new(q);
+    X.slots[es] = ExactEntry{bx, by, bz, w, X.gen};
     return w;
   }
 
@@ -402,68 +489,75 @@ class Decomposer {
     return true;
   }
 
-  /// welded_ring() and, in the same pass, the ring's Newell normal and bounding box (repeated
-  /// vertices add exact zeros to the normal, so it does not matter that they are still there).
+  /// Welded id of mesh vertex vi while no two vertices lie within tol (grid_ false): its distinct
+  /// point's id, given in order of first use.
+  std::uint32_t weld_apart(std::uint32_t vi) {
+    const std::uint32_t d = ws_.distinct_of[vi];
+    if (d == kBad) return kBad;
+    std::uint32_t& f = ws_.distinct_weld[d];
+    if (f == kNone) {
+      f = static_cast<std::uint32_t>(ws_.wpos.size());
+      ws_.wpos.push_back(ws_.distinct_pos[d]);  // reserved: data() does not move
+    }
+    return f;
+  }
+
+  /// welded_ring() into ring_buf (ring_len_ vertices) and, in the same pass, the ring's Newell
+  /// normal and bounding box (repeated vertices add exact zeros to the normal, so it does not
+  /// matter that they are still there).
+  template <bool Grid>
   bool welded_ring_normal(std::uint32_t r, V3& n, V3& lo, V3& hi) {
-    auto& out = ws_.ring_tmp;
-    out.clear();
+    std::uint32_t* out = ws_.ring_buf.data();
+    std::size_t len = 0;
+    ring_len_ = 0;
     n = V3{};
     const std::uint32_t a = m_.ring_offsets[r], b = m_.ring_offsets[r + 1];
     if (a >= b) return true;
+    const std::uint32_t* idx = m_.indices.data();
     const std::size_t nv = m_.vertices.size();
-    const V3* W = nullptr;
+    const V3* W = ws_.wpos.data();  // reserved for every distinct point: welding does not move it
     V3 first, prev;
-    for (std::uint32_t k = a; k < b; ++k) {
-      const std::uint32_t vi = m_.indices[k];
+    {
+      const std::uint32_t vi = idx[a];
       if (vi >= nv) return false;
-      const std::uint32_t w = weld_vertex(vi);
+      const std::uint32_t w = Grid ? weld_vertex(vi) : weld_apart(vi);
       if (w == kBad) return false;
-      W = ws_.wpos.data();  // weld_vertex may grow wpos
+      first = prev = lo = hi = W[w];
+      out[len++] = w;
+    }
+    for (std::uint32_t k = a + 1; k < b; ++k) {
+      const std::uint32_t vi = idx[k];
+      if (vi >= nv) return false;
+      const std::uint32_t w = Grid ? weld_vertex(vi) : weld_apart(vi);
+      if (w == kBad) return false;
       const V3 p = W[w];
-      if (k == a) {
-        first = p;
-        lo = hi = p;
-      } else {
-        n.x += (prev.y - p.y) * (prev.z + p.z);
-        n.y += (prev.z - p.z) * (prev.x + p.x);
-        n.z += (prev.x - p.x) * (prev.y + p.y);
-        lo.x = std::min(lo.x, p.x), lo.y = std::min(lo.y, p.y), lo.z = std::min(lo.z, p.z);
-        hi.x = std::max(hi.x, p.x), hi.y = std::max(hi.y, p.y), hi.z = std::max(hi.z, p.z);
-      }
+      n.x += (prev.y - p.y) * (prev.z + p.z);
+      n.y += (prev.z - p.z) * (prev.x + p.x);
+      n.z += (prev.x - p.x) * (prev.y + p.y);
+      lo.x = std::min(lo.x, p.x), lo.y = std::min(lo.y, p.y), lo.z = std::min(lo.z, p.z);
+      hi.x = std::max(hi.x, p.x), hi.y = std::max(hi.y, p.y), hi.z = std::max(hi.z, p.z);
       prev = p;
-      if (out.empty() || out.back() != w) out.push_back(w);
+      if (out[len - 1] != w) out[len++] = w;
     }
     n.x += (prev.y - first.y) * (prev.z + first.z);
     n.y += (prev.z - first.z) * (prev.x + first.x);
     n.z += (prev.x - first.x) * (prev.y + first.y);
-    while (out.size() > 1 && out.back() == out.front()) out.pop_back();
+    while (len > 1 && out[len - 1] == out[0]) --len;
+    ring_len_ = len;
     return true;
   }
 
-  V3 newell_tmp() const {
-    V3 n;
-    const auto& r = ws_.ring_tmp;
-    for (std::size_t k = 0; k < r.size(); ++k) {
-      const V3& p = ws_.wpos[r[k]];
-      const V3& q = ws_.wpos[r[k + 1 < r.size() ? k + 1 : 0]];
-      n.x += (p.y - q.y) * (p.z + q.z);
-      n.y += (p.z - q.z) * (p.x + q.x);
-      n.z += (p.x - q.x) * (p.y + q.y);
-    }
-    return n;
-  }
-
   // ---- 2. faces and half-edges ------------------------------------------------------------------
-  /// Remembers the face's welded outer ring (ring_tmp); a face seen before with the same ring (any
+  /// Remembers the face's welded outer ring (ring_buf); a face seen before with the same ring (any
   /// start, either direction) and ring count is noted in `dups` for resolve_duplicates(), with
   /// `fwd` telling whether it runs the way the first one does. The hash does not depend on start
   /// or direction, so nothing is rotated unless two hashes meet.
   void note_face(std::uint32_t f, std::uint32_t ring_count) {
-    const auto& r = ws_.ring_tmp;
-    const std::size_t k = r.size();
+    const std::uint32_t* r = ws_.ring_buf.data();
+    const std::size_t k = ring_len_;
     std::uint64_t sum = 0, x = 0;
-    for (std::uint32_t v : r) {
-      const std::uint64_t m = (v + 1) * 0x9E3779B97F4A7C15ULL;
+    for (std::size_t i = 0; i < k; ++i) {
+      const std::uint64_t m = (r[i] + 1) * 0x9E3779B97F4A7C15ULL;
       sum += m ^ (m >> 29);
       x ^= m;
     }
@@ -473,11 +567,11 @@ class Decomposer {
       FaceEntry& e = T.slots[s];
       if (e.gen != T.gen) {
         e = FaceEntry{h, f, static_cast<std::uint32_t>(ws_.canon.size()), static_cast<std::uint32_t>(k), ring_count, T.gen};
-        ws_.canon.insert(ws_.canon.end(), r.begin(), r.end());
+        ws_.canon.insert(ws_.canon.end(), r, r + k);
         return;
       }
       if (e.hash != h || e.count != k || e.rings != ring_count) continue;
-      const int dir = same_cycle(ws_.canon.data() + e.first, r.data(), k);
+      const int dir = same_cycle(ws_.canon.data() + e.first, r, k);
       if (dir == 0) continue;
       if (ws_.dups.empty() || ws_.dups.back().slot != s || ws_.dups.back().face != e.face)
         ws_.dups.push_back(Dup{static_cast<std::uint32_t>(s), e.face, true});
@@ -540,33 +634,48 @@ class Decomposer {
     inv_cell_ = 1.0 / (kCell * tol_);
     const double cos_tol = std::cos(std::clamp(p_.proxy_tolerance_deg, 0.0, 89.0) * kPi / 180.0);
     cos2_tol_ = cos_tol * cos_tol;
-    ws_.weld.assign(m_.vertices.size(), kNone);
     ws_.wpos.clear();
-    const std::size_t distinct = std::min(m_.indices.size(), m_.vertices.size());
-    ws_.weld_table.start(distinct);
-    ws_.exact_table.start(distinct);
+    grid_ = !distinct_apart();
+    ws_.wpos.reserve(ws_.distinct_pos.size());
+    if (grid_) {
+      ws_.weld.assign(m_.vertices.size(), kNone);
+      const std::size_t distinct = std::min(m_.indices.size(), m_.vertices.size());
+      ws_.weld_table.start(distinct);
+      ws_.exact_table.start(distinct);
+    }
+    if (ws_.ring_buf.size() < m_.indices.size()) ws_.ring_buf.resize(m_.indices.size());
     ws_.faces.assign(m_.faces.size(), FaceInfo{});
     ws_.face_table.start(m_.faces.size());
     ws_.canon.clear();
     ws_.dups.clear();
     ws_.halfedges.clear();
     ws_.halfedges.reserve(m_.indices.size());
+    if (grid_) build_face_rings<true>();
+    else build_face_rings<false>();
+    stats_->vertices_welded = ws_.wpos.size();
+  }
+
+  template <bool Grid>
+  void build_face_rings() {
     const std::size_t nrings = m_.ring_count();
     V3 n, lo, hi, nh, hlo, hhi;
-    for (std::uint32_t f = 0; f < m_.faces.size(); ++f) {
-      const MeshFace& mf = m_.faces[f];
-      FaceInfo& fi = ws_.faces[f];
+    const MeshFace* MF = m_.faces.data();
+    FaceInfo* FI = ws_.faces.data();
+    const std::uint32_t nf = static_cast<std::uint32_t>(m_.faces.size());
+    for (std::uint32_t f = 0; f < nf; ++f) {
+      const MeshFace& mf = MF[f];
+      FaceInfo& fi = FI[f];
       fi.uf = f;
       if (mf.kind == SurfaceKind::FootPrint || mf.kind == SurfaceKind::RoofEdge) continue;
       if (mf.ring_count == 0 || std::size_t(mf.first_ring) + mf.ring_count > nrings) continue;
-      if (!welded_ring_normal(mf.first_ring, n, lo, hi) || ws_.ring_tmp.size() < 3) continue;
+      if (!welded_ring_normal<Grid>(mf.first_ring, n, lo, hi) || ring_len_ < 3) continue;
       const double len2 = dot(n, n);
       if (!(len2 > 1e-24)) continue;  // zero area: no orientation, no class
       note_face(f, mf.ring_count);
       fi.n = n;
       fi.len = std::sqrt(len2);
       fi.net = n;
-      fi.c = ws_.wpos[ws_.ring_tmp[0]];
+      fi.c = ws_.wpos[ws_.ring_buf[0]];
       fi.lo = lo;
       fi.hi = hi;
       // Walls are within the proxy tolerance of vertical either way up; floor or ceiling waits for
@@ -576,88 +685,107 @@ class Decomposer {
       ++stats_->faces_used;
       add_ring_edges(f, n, len2, wall, false);
       for (std::uint32_t r = mf.first_ring + 1; r < mf.first_ring + mf.ring_count; ++r) {
-        if (!welded_ring_normal(r, nh, hlo, hhi) || ws_.ring_tmp.size() < 3) continue;
+        if (!welded_ring_normal<Grid>(r, nh, hlo, hhi) || ring_len_ < 3) continue;
         // Holes run against the outer ring so that the face lies on their left; turn those that don't.
         const bool same = dot(nh, n) > 0;
         fi.net = same ? fi.net - nh : V3{fi.net.x + nh.x, fi.net.y + nh.y, fi.net.z + nh.z};
         add_ring_edges(f, n, len2, wall, same);
       }
     }
-    stats_->vertices_welded = ws_.wpos.size();
   }
 
   void add_ring_edges(std::uint32_t f, const V3& n, double len2, bool wall, bool reverse) {
-    const auto& r = ws_.ring_tmp;
-    const std::size_t k = r.size();
+    const std::uint32_t* r = ws_.ring_buf.data();
+    const std::size_t k = ring_len_;
+    auto& he = ws_.halfedges;
+    const std::size_t base = he.size();
+    he.resize(base + k);  // reserved for every index: no reallocation
+    HalfEdge* out = he.data() + base;
+    const V3* W = ws_.wpos.data();
     for (std::size_t i = 0; i < k; ++i) {
       std::uint32_t a = r[i], b = r[i + 1 < k ? i + 1 : 0];
       if (reverse) std::swap(a, b);
-      ws_.halfedges.push_back(HalfEdge{a, b, f, wall ? rise(n, len2, a, b) : std::int8_t{0}});
+      out[i] = HalfEdge{a, b, f, wall ? rise(W, n, len2, a, b) : std::int8_t{0}};
     }
   }
 
   /// HalfEdge::up of a wall facet with Newell normal n (|n|^2 = len2) along a -> b: the sign of
   /// (n x d).z / (|n| |d|) beyond +-kRise, decided on squares (no square root, no division).
-  std::int8_t rise(const V3& n, double len2, std::uint32_t a, std::uint32_t b) const {
-    const V3 d = ws_.wpos[b] - ws_.wpos[a];
+  static std::int8_t rise(const V3* W, const V3& n, double len2, std::uint32_t a, std::uint32_t b) {
+    const V3 d = W[b] - W[a];
     const double c = n.x * d.y - n.y * d.x;  // (n x d).z
     if (!(c * c > kRise * kRise * len2 * dot(d, d))) return 0;
     return c > 0 ? 1 : -1;
   }
 
-  /// Half-edges grouped by undirected welded edge (open addressing, multiplicative hash), then
-  /// group_members in group order by a counting sort.
+  /// Half-edges grouped by undirected welded edge, groups numbered in order of first appearance:
+  /// the earlier half-edges with the same smaller vertex are chained per vertex (a handful), so a
+  /// half-edge finds its group by walking that chain. Then group_members in group order by a
+  /// counting sort.
   void group_edges() {
-    const std::size_t nh = ws_.halfedges.size();
-    auto& T = ws_.edge_table;
-    const std::uint32_t gen = T.start(nh);
-    int shift = 64;
-    for (std::size_t m = T.mask; m; m >>= 1) --shift;
-    const std::size_t mask = T.mask;
+    const std::size_t nh = ws_.halfedges.size(), nv = ws_.wpos.size();
+    auto& head = ws_.bucket_start;  // per smaller vertex: latest half-edge with it, kNone if none
+    head.assign(nv, kNone);
+    ws_.he_next.resize(nh);
+    ws_.he_max.resize(nh);
     ws_.he_group.resize(nh);
+    std::uint32_t* H0 = head.data();
+    std::uint32_t* next = ws_.he_next.data();
+    std::uint32_t* hmax = ws_.he_max.data();
+    std::uint32_t* grp = ws_.he_group.data();
     auto& count = ws_.group_count;
-    count.clear();
+    count.resize(nh);  // at most one group per half-edge
+    std::uint32_t* cnt = count.data();
+    std::uint32_t ng = 0;
     const HalfEdge* H = ws_.halfedges.data();
-    for (std::size_t i = 0; i < nh; ++i) {
-      const std::uint64_t key = H[i].a < H[i].b ? (std::uint64_t(H[i].a) << 32 | H[i].b) : (std::uint64_t(H[i].b) << 32 | H[i].a);
-      std::size_t s = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ULL) >> shift);
-      while (T.slots[s].gen == gen && T.slots[s].key != key) s = (s + 1) & mask;
-      EdgeEntry& e = T.slots[s];
-      if (e.gen != gen) {
-        e = EdgeEntry{key, static_cast<std::uint32_t>(count.size()), gen};
-        count.push_back(0);
+    for (std::uint32_t i = 0; i < nh; ++i) {
+      const std::uint32_t lo = std::min(H[i].a, H[i].b), hi = std::max(H[i].a, H[i].b);
+      std::uint32_t j = H0[lo];
+      while (j != kNone && hmax[j] != hi) j = next[j];
+      std::uint32_t g;
+      if (j == kNone) {
+        g = ng++;
+        cnt[g] = 0;
+      } else {
+        g = grp[j];
       }
-      ws_.he_group[i] = e.group;
-      ++count[e.group];
+      grp[i] = g;
+      ++cnt[g];
+      hmax[i] = hi;
+      next[i] = H0[lo];
+      H0[lo] = i;
     }
-    const std::size_t ng = count.size();
+    count.resize(ng);
     auto& start = ws_.group_start;
     start.resize(ng + 1);
-    start[0] = 0;
-    for (std::size_t g = 0; g < ng; ++g) start[g + 1] = start[g] + count[g];
+    std::uint32_t* st = start.data();
+    st[0] = 0;
+    for (std::size_t g = 0; g < ng; ++g) st[g + 1] = st[g] + cnt[g];
     auto& cursor = ws_.bucket_start;
     cursor.assign(start.begin(), start.end() - 1);
+    std::uint32_t* cur = cursor.data();
     ws_.group_members.resize(nh);
-    for (std::size_t i = 0; i < nh; ++i) ws_.group_members[cursor[ws_.he_group[i]]++] = static_cast<std::uint32_t>(i);
+    std::uint32_t* mem = ws_.group_members.data();
+    for (std::uint32_t i = 0; i < nh; ++i) mem[cur[grp[i]]++] = i;
   }
 
   // ---- T-junctions ------------------------------------------------------------------------------
   /// Splits every edge seen by one facet at the ends of other such edges lying on it (within tol).
   /// Returns whether anything was split (then the edges must be regrouped).
   bool split_t_junctions() {
+    // Nearly every mesh has none: a look with the split's own test first (open_end_on_open_edge),
+    // and only where an end lies on an edge the split as it always was.
+    if (!open_end_on_open_edge()) return false;
     auto& ends = ws_.xends;
     ends.clear();
     const std::size_t ng = ws_.group_count.size();
-    std::size_t unmatched = 0;
     const auto& P = ws_.wpos;
     for (std::size_t g = 0; g < ng; ++g) {
       if (ws_.group_count[g] != 1) continue;
       const HalfEdge& h = ws_.halfedges[ws_.group_members[ws_.group_start[g]]];
       ends.push_back(XEnd{P[h.a].x, P[h.a].y, P[h.a].z, h.a});
       ends.push_back(XEnd{P[h.b].x, P[h.b].y, P[h.b].z, h.b});
-      ++unmatched;
     }
-    if (unmatched < 2) return false;
     std::sort(ends.begin(), ends.end(), [](const XEnd& u, const XEnd& v) { return u.x < v.x || (u.x == v.x && u.v < v.v); });
     ends.erase(std::unique(ends.begin(), ends.end(), [](const XEnd& u, const XEnd& v) { return u.v == v.v; }), ends.end());
 
@@ -719,7 +847,7 @@ class Decomposer {
       for (int k = 0; k <= nhits; ++k) {
         const std::uint32_t next = k < nhits ? hits[k].v : h.b;
         if (next == prev) continue;
-        out.push_back(HalfEdge{prev, next, h.face, fi.cls == kWall ? rise(fi.n, fi.len * fi.len, prev, next) : std::int8_t{0}});
+        out.push_back(HalfEdge{prev, next, h.face, fi.cls == kWall ? rise(P.data(), fi.n, fi.len * fi.len, prev, next) : std::int8_t{0}});
         prev = next;
       }
     }
@@ -727,16 +855,85 @@ class Decomposer {
     return any;
   }
 
+  /// Whether some end of an edge seen by one facet lies on another such edge by the split's test
+  /// (x within the edge's x range widened by tol, then 0 < t < 1 and squared offset within tol^2):
+  /// exactly when the split would split something. Fewer than two such edges: never. The ends (each
+  /// vertex once) are tried against every edge when there are few (a closed part without its ground
+  /// has its bottom ring), else in x order from a binary search.
+  bool open_end_on_open_edge() {
+    const std::size_t ng = ws_.group_count.size();
+    const V3* P = ws_.wpos.data();
+    auto& edges = ws_.open_he;
+    edges.clear();
+    auto& ends = ws_.weld_sort;  // (x, vertex), each vertex once
+    ends.clear();
+    auto& seen = ws_.end_seen;
+    if (seen.size() < ws_.wpos.size()) seen.resize(ws_.wpos.size(), 0);
+    if (++ws_.end_gen == 0) {
+      std::fill(seen.begin(), seen.end(), 0);
+      ws_.end_gen = 1;
+    }
+    const std::uint32_t gen = ws_.end_gen;
+    const std::uint32_t* cnt = ws_.group_count.data();
+    const std::uint32_t* st = ws_.group_start.data();
+    const std::uint32_t* mem = ws_.group_members.data();
+    const HalfEdge* H = ws_.halfedges.data();
+    for (std::size_t g = 0; g < ng; ++g) {
+      if (cnt[g] != 1) continue;
+      const HalfEdge& h = H[mem[st[g]]];
+      edges.push_back(mem[st[g]]);
+      if (seen[h.a] != gen) seen[h.a] = gen, ends.push_back(XId{P[h.a].x, h.a});
+      if (seen[h.b] != gen) seen[h.b] = gen, ends.push_back(XId{P[h.b].x, h.b});
+    }
+    const std::size_t ne = edges.size(), nx = ends.size();
+    if (ne < 2) return false;
+    const double tol2 = tol_ * tol_;
+    const XId* E = ends.data();
+    const bool sorted = ne * nx > 1024;
+    if (sorted) std::sort(ends.begin(), ends.end(), [](const XId& u, const XId& v) { return u.x < v.x; });
+    for (std::size_t i = 0; i < ne; ++i) {
+      const HalfEdge& h = H[edges[i]];
+      const V3 &A = P[h.a], &B = P[h.b];
+      const V3 d = B - A;
+      const double L2 = dot(d, d);
+      const double xlo = std::min(A.x, B.x) - tol_, xhi = std::max(A.x, B.x) + tol_;
+      std::size_t j = 0, stop = nx;
+      if (sorted) j = std::lower_bound(E, E + nx, xlo, [](const XId& u, double x) { return u.x < x; }) - E;
+      for (; j < stop; ++j) {
+        const double x = E[j].x;
+        if (!(x <= xhi)) {
+          if (sorted) break;
+          continue;
+        }
+        if (!(x >= xlo)) continue;
+        const std::uint32_t v = E[j].id;
+        if (v == h.a || v == h.b) continue;
+        const V3 ap = P[v] - A;
+        const double t = dot(ap, d) / L2;
+        if (!(t > 0) || !(t < 1)) continue;
+        const V3 off{ap.x - t * d.x, ap.y - t * d.y, ap.z - t * d.z};
+        if (dot(off, off) > tol2) continue;
+        return true;
+      }
+    }
+    return false;
+  }
+
   // ---- 3. orientation ---------------------------------------------------------------------------
   void orient() {
-    auto& F = ws_.faces;
+    FaceInfo* F = ws_.faces.data();
     const std::size_t ng = ws_.group_count.size();
+    const std::uint32_t* cnt = ws_.group_count.data();
+    const std::uint32_t* st = ws_.group_start.data();
+    const std::uint32_t* mem = ws_.group_members.data();
+    const HalfEdge* H = ws_.halfedges.data();
+    std::size_t nonmanifold = 0;
     for (std::size_t g = 0; g < ng; ++g) {
-      const std::uint32_t c = ws_.group_count[g];
-      if (c > 2) ++stats_->nonmanifold_edges;
+      const std::uint32_t c = cnt[g];
+      nonmanifold += c > 2;
       if (c != 2) continue;
-      const HalfEdge& h1 = ws_.halfedges[ws_.group_members[ws_.group_start[g]]];
-      const HalfEdge& h2 = ws_.halfedges[ws_.group_members[ws_.group_start[g] + 1]];
+      const HalfEdge& h1 = H[mem[st[g]]];
+      const HalfEdge& h2 = H[mem[st[g] + 1]];
       if (h1.face == h2.face) continue;
       // Consistent neighbours run the shared edge in opposite directions.
       const std::uint8_t rel = h1.a == h2.a ? 1 : 0;
@@ -746,26 +943,34 @@ class Decomposer {
       F[r2].uf = r1;
       F[r2].parity = static_cast<std::uint8_t>(p1 ^ p2 ^ rel);
     }
+    stats_->nonmanifold_edges += nonmanifold;
     // Dense component ids and parities, bounding boxes, then signed volumes about each part's low point.
-    const std::size_t nf = F.size();
+    const std::size_t nf = ws_.faces.size();
     ws_.comp_index.assign(nf, kNone);
-    ws_.face_comp.assign(nf, kNone);
-    ws_.face_par.assign(nf, 0);
+    ws_.face_comp.resize(nf);
+    ws_.face_par.resize(nf);
+    std::uint32_t* cidx = ws_.comp_index.data();
+    std::uint32_t* fcomp = ws_.face_comp.data();
+    std::uint8_t* fpar = ws_.face_par.data();
     ws_.comp_lo.clear();
     ws_.comp_hi.clear();
     ncomp_ = 0;
     constexpr double inf = std::numeric_limits<double>::infinity();
     for (std::uint32_t f = 0; f < nf; ++f) {
-      if (F[f].cls == kSkipped) continue;
+      if (F[f].cls == kSkipped) {
+        fcomp[f] = kNone;
+        fpar[f] = 0;
+        continue;
+      }
       std::uint8_t par;
       const std::uint32_t r = uf_find(F, f, par);
-      if (ws_.comp_index[r] == kNone) {
-        ws_.comp_index[r] = static_cast<std::uint32_t>(ncomp_++);
+      if (cidx[r] == kNone) {
+        cidx[r] = static_cast<std::uint32_t>(ncomp_++);
         ws_.comp_lo.push_back(V3{inf, inf, inf});
         ws_.comp_hi.push_back(V3{-inf, -inf, -inf});
       }
-      ws_.face_comp[f] = ws_.comp_index[r];
-      ws_.face_par[f] = par;
+      fcomp[f] = cidx[r];
+      fpar[f] = par;
     }
     stats_->components = ncomp_;
     // Signed volume of each part about its low point org (bounding-box centre in x, y; lowest z):
@@ -775,37 +980,45 @@ class Decomposer {
     ws_.comp_vol.assign(ncomp_, 0);
     ws_.comp_area.assign(ncomp_, 0);
     ws_.comp_net.assign(ncomp_, V3{});
+    V3* CLO = ws_.comp_lo.data();
+    V3* CHI = ws_.comp_hi.data();
+    double* CVOL = ws_.comp_vol.data();
+    double* CAREA = ws_.comp_area.data();
+    V3* CNET = ws_.comp_net.data();
     for (std::uint32_t f = 0; f < nf; ++f) {
       if (F[f].cls == kSkipped) continue;
       const FaceInfo& fi = F[f];
-      const std::uint32_t c = ws_.face_comp[f];
-      V3& lo = ws_.comp_lo[c];
-      V3& hi = ws_.comp_hi[c];
+      const std::uint32_t c = fcomp[f];
+      V3& lo = CLO[c];
+      V3& hi = CHI[c];
       lo.x = std::min(lo.x, fi.lo.x), lo.y = std::min(lo.y, fi.lo.y), lo.z = std::min(lo.z, fi.lo.z);
       hi.x = std::max(hi.x, fi.hi.x), hi.y = std::max(hi.y, fi.hi.y), hi.z = std::max(hi.z, fi.hi.z);
-      ws_.comp_area[c] += fi.len / 2;
-      const double s = ws_.face_par[f] ? -1.0 : 1.0;
-      ws_.comp_vol[c] += s * dot(fi.net, fi.c);
-      V3& N = ws_.comp_net[c];
+      CAREA[c] += fi.len / 2;
+      const double s = fpar[f] ? -1.0 : 1.0;
+      CVOL[c] += s * dot(fi.net, fi.c);
+      V3& N = CNET[c];
       N.x += s * fi.net.x, N.y += s * fi.net.y, N.z += s * fi.net.z;
     }
     for (std::size_t c = 0; c < ncomp_; ++c) {
-      const V3 org{(ws_.comp_lo[c].x + ws_.comp_hi[c].x) / 2, (ws_.comp_lo[c].y + ws_.comp_hi[c].y) / 2, ws_.comp_lo[c].z};
-      ws_.comp_vol[c] = (ws_.comp_vol[c] - dot(ws_.comp_net[c], org)) / 6;
+      const V3 org{(CLO[c].x + CHI[c].x) / 2, (CLO[c].y + CHI[c].y) / 2, CLO[c].z};
+      CVOL[c] = (CVOL[c] - dot(CNET[c], org)) / 6;
     }
     ws_.comp_sign.assign(ncomp_, 0);
+    std::int8_t* CS = ws_.comp_sign.data();
     for (std::size_t c = 0; c < ncomp_; ++c) {
-      const double scale = std::pow(std::max(ws_.comp_area[c], 1e-12), 1.5);
-      const double v = ws_.comp_vol[c];
-      if (std::fabs(v) > 1e-6 * scale) ws_.comp_sign[c] = v > 0 ? 1 : -1;
+      const double scale = std::pow(std::max(CAREA[c], 1e-12), 1.5);
+      const double v = CVOL[c];
+      if (std::fabs(v) > 1e-6 * scale) CS[c] = v > 0 ? 1 : -1;
       else ++stats_->unoriented_components;
     }
+    std::size_t flipped = 0;
     for (std::uint32_t f = 0; f < nf; ++f) {
       if (F[f].cls == kSkipped) continue;
-      const std::int8_t cs = ws_.comp_sign[ws_.face_comp[f]] == 0 ? 1 : ws_.comp_sign[ws_.face_comp[f]];
-      F[f].sign = static_cast<std::int8_t>(ws_.face_par[f] ? -cs : cs);
-      if (F[f].sign < 0) ++stats_->flipped_faces;
+      const std::int8_t cs = CS[fcomp[f]] == 0 ? 1 : CS[fcomp[f]];
+      F[f].sign = static_cast<std::int8_t>(fpar[f] ? -cs : cs);
+      flipped += F[f].sign < 0;
     }
+    stats_->flipped_faces += flipped;
   }
 
   // ---- 4. decomposition -------------------------------------------------------------------------
@@ -926,15 +1139,21 @@ class Decomposer {
     auto& cand = ws_.cand;
     cand.clear();
     const std::size_t ng = ws_.group_count.size();
+    const std::uint32_t* cnt = ws_.group_count.data();
+    const std::uint32_t* st = ws_.group_start.data();
+    const std::uint32_t* mem = ws_.group_members.data();
+    const HalfEdge* H = ws_.halfedges.data();
+    const FaceInfo* F = ws_.faces.data();
+    const std::uint8_t* hanging = ws_.hanging.data();
     for (std::size_t g = 0; g < ng; ++g) {
-      const std::uint32_t s = ws_.group_start[g], c = ws_.group_count[g];
+      const std::uint32_t s = st[g], c = cnt[g];
       int net = 0;
       bool below = false;
       std::uint32_t comp = kNone, lo = 0, hi = 0;
       for (std::uint32_t i = 0; i < c; ++i) {
-        const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
-        const FaceInfo& fi = ws_.faces[h.face];
-        if (fi.cls == kCeiling || (fi.cls == kFloor && ws_.hanging[h.face])) {
+        const HalfEdge& h = H[mem[s + i]];
+        const FaceInfo& fi = F[h.face];
+        if (fi.cls == kCeiling || (fi.cls == kFloor && hanging[h.face])) {
           // A ceiling boundary (paper §4: "except the ceiling boundaries"): walls rising from a roof
           // (the inside of a parapet, a penthouse) stand on the building, not on the ground; so do
           // walls rising from a soffit.
