@@ -97,8 +97,7 @@ struct DirEdge {
 };
 
 struct ExactEntry {
-  std::uint64_t bx, by, bz;  // the coordinates' bits
-  std::uint32_t rep;         // their welded id
+  std::uint32_t vertex, rep;  // a mesh vertex with these coordinates (bit for bit), their id
   std::uint32_t gen;
 };
 
@@ -392,12 +391,12 @@ class Decomposer {
         const ExactEntry& e = X.slots[es];
         if (e.gen != X.gen) {
           const std::uint32_t d = static_cast<std::uint32_t>(pos.size());
-          X.slots[es] = ExactEntry{bx, by, bz, d, X.gen};
+          X.slots[es] = ExactEntry{vi, d, X.gen};
           pos.push_back(V3{q.x - o_.x, q.y - o_.y, q.z - o_.z});
           of[vi] = d;
           break;
         }
-        if (e.bx == bx && e.by == by && e.bz == bz) {
+        if (std::memcmp(&m_.vertices[e.vertex], &q, sizeof(Point3)) == 0) {
           of[vi] = e.rep;
           break;
         }
@@ -434,10 +433,10 @@ class Decomposer {
     for (;; es = (es + 1) & X.mask) {
       const ExactEntry& e = X.slots[es];
       if (e.gen != X.gen) break;
-      if (e.bx == bx && e.by == by && e.bz == bz) return e.rep;
+      if (std::memcmp(&m_.vertices[e.vertex], &q, sizeof(Point3)) == 0) return e.rep;
     }
     const std::uint32_t w = weld_new(q);
-    X.slots[es] = ExactEntry{bx, by, bz, w, X.gen};
+    X.slots[es] = ExactEntry{vi, w, X.gen};
     return w;
   }
 
