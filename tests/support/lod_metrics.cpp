@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -101,6 +103,19 @@ LodMetrics measure_plans(const std::vector<GroundPlan>& plans, double small_hole
     double a = 0;
     if (!added || GEOSArea_r(g.h, added, &a) != 1) throw std::runtime_error("GEOS closing failed");
     m.closing_residual_m2 = a;
+    if (std::getenv("GROUNDPLAN_LOD_DEBUG") && a > 0) {  // where is it? (for a person investigating)
+      const int n = GEOSGetNumGeometries_r(g.h, added);
+      for (int i = 0; i < n; ++i) {
+        const GEOSGeometry* piece = GEOSGetGeometryN_r(g.h, added, i);
+        double pa = 0;
+        GEOSArea_r(g.h, piece, &pa);
+        if (pa > 1e-4 * a || pa > 1e-6) {
+          char* wkt = GEOSGeomToWKT_r(g.h, piece);
+          std::fprintf(stderr, "closing residual piece %.3g m2: %.300s\n", pa, wkt);
+          GEOSFree_r(g.h, wkt);
+        }
+      }
+    }
     GEOSGeom_destroy_r(g.h, added);
     GEOSGeom_destroy_r(g.h, clo);
     GEOSGeom_destroy_r(g.h, dil);

@@ -55,7 +55,8 @@ struct LodStats {
 /// vertex (footprint order, then ring order) moves onto it (no chaining: kept vertices are more than
 /// `tolerance_m` apart), then every kept vertex within `tolerance_m` of an edge of another ring is
 /// inserted into that edge. Almost-touching walls then share their vertices exactly, so the exact
-/// union joins them. Each vertex moves at most `tolerance_m`; each edge at most `tolerance_m`.
+/// union joins them. Each vertex moves at most `tolerance_m`; an edge at most 2 `tolerance_m` (its ends move, then a
+/// vertex within `tolerance_m` of the moved edge is inserted).
 /// Consecutive repeated points are removed; a ring left with < 3 points is dropped (counted).
 std::vector<Footprint> snap_footprints(const std::vector<Footprint>& footprints, double tolerance_m,
                                        LodStats* stats = nullptr);

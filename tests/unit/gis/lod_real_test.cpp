@@ -102,7 +102,7 @@ TEST_P(LodOnRealData, EverySettingGivesValidDisjointPlans) {
     EXPECT_EQ(m.invalid, 0u);
     EXPECT_EQ(m.overlapping_pairs, 0u);
     expect_nothing_lost(r, out);
-    if (lod.close_gaps_m > 0) {
+    if (lod.close_gaps_m > 0 && lod.simplify_m == 0 && lod.min_area_m2 == 0 && lod.snap_m == 0) {
       // The closing contains the input: area never lost.
       const testing::LodMetrics m0 = testing::measure_plans(r.plans, 0, 0, 0);
       EXPECT_GE(m.area_m2, m0.area_m2 * (1 - 1e-12));
