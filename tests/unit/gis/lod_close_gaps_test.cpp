@@ -31,8 +31,6 @@ UnionParams one_thread() {
   return p;
 }
 
-Polygon rect(double x0, double y0, double x1, double y1) { return Polygon{{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, {}}; }
-
 // Plans as the pipeline makes them: the exact union of one footprint per polygon.
 std::vector<GroundPlan> plans_of(const std::vector<Polygon>& polys, std::vector<Footprint>* fps_out = nullptr) {
   std::vector<Footprint> fps;
@@ -277,7 +275,9 @@ TEST(LodCloseGaps, USlotAndNarrowNotchFillWideNotchStays) {
     const auto out = close_gaps(in, 0.1, one_thread());
     ASSERT_EQ(out.size(), 1u);
     const std::vector<Point2> corners{f(0, 0), f(10, 0), f(10, 10), f(0, 10), f(0, 6), f(0.06, 6), f(0.06, 5), f(0, 5)};
-    if (f.angle == 0) EXPECT_EQ(sorted(out[0].polygon.outer), sorted(corners));
+    if (f.angle == 0) {
+      EXPECT_EQ(sorted(out[0].polygon.outer), sorted(corners));
+    }
     expect_input_vertices(out[0], in, corners, {f(3, 0.06), f(3.08, 0.06), f(5, 3), f(5.08, 3)});
     check_against_geos(in, out, 0.1);
   }
