@@ -72,6 +72,29 @@ bool strictly_inside(const Ring& r, const Point2& p) {
   return odd;
 }
 
+/// Is ring `r` (the outer ring of a plan disjoint from the hole's owner) inside hole `h`? Plans meet
+/// at points only, so r's vertices are all inside h or on it, or all outside or on it. When every
+/// vertex lies on h (a triangle wedged into three corners of the hole), an edge's midpoint decides:
+/// r's edges are not on h (that would join the plans), so a midpoint is inside or outside.
+bool ring_inside(const Ring& r, const Ring& h) {
+  for (const Point2& p : r) {
+    if (strictly_inside(h, p)) return true;
+    bool on = false;
+    for (std::size_t i = 0, n = h.size(); i < n && !on; ++i) {
+      const Point2& a = h[i];
+      const Point2& b = h[(i + 1) % n];
+      on = robust::orient(a, b, p) == 0 && std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) &&
+           std::min(a.y, b.y) <= p.y && p.y <= std::max(a.y, b.y);
+    }
+    if (!on) return false;
+  }
+  for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+    const Point2 m{(r[i].x + r[(i + 1) % n].x) / 2, (r[i].y + r[(i + 1) % n].y) / 2};
+    if (strictly_inside(h, m)) return true;
+  }
+  return false;
+}
+
 /// "a, b, c (+N more)": the buildings of a plan, for a message.
 std::string plan_ids(const GroundPlan& g, const std::vector<Footprint>& footprints) {
   std::string s;
@@ -123,16 +146,7 @@ std::size_t fill_holes(std::vector<GroundPlan>& plans, const Fill& fill, const s
       for (; it != by_minx.end() && boxes[*it].minx <= hb.maxx; ++it) {
         const std::size_t j = *it;
         if (j == pi || absorbed[j] || !hb.contains(boxes[j])) continue;
-        if (!strictly_inside(h, plans[j].polygon.outer[0])) {
-          // The island may touch the hole at its first vertex: decide by another vertex.
-          bool in = false;
-          for (const Point2& p : plans[j].polygon.outer)
-            if (strictly_inside(h, p)) {
-              in = true;
-              break;
-            }
-          if (!in) continue;
-        }
+        if (!ring_inside(plans[j].polygon.outer, h)) continue;
         absorbed[j] = 1;
         ++islands;
         std::vector<std::uint32_t> merged;

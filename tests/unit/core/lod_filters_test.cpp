@@ -117,6 +117,22 @@ TEST(LodFilters, FillingAHoleJoinsTheIslandInsideIt) {
   EXPECT_NEAR(plans[0].area_m2, 100, 1e-9);
 }
 
+TEST(LodFilters, AnIslandTouchingItsHoleAtEveryVertexJoinsToo) {
+  // A triangle wedged into a 2 x 2 hole with its three corners on the hole's sides: a plan of its own
+  // (plans meet at points), none of its vertices strictly inside the hole. Found by fuzz_lod.
+  auto fps = footprints_from_wkt({"POLYGON((0 0, 10 0, 10 10, 0 10, 0 0), (4 4, 4 6, 6 6, 6 4, 4 4))",
+                                  "POLYGON((5 4, 6 5, 4 5, 5 4))"});
+  std::vector<Problem> problems;
+  LodParams lod;
+  lod.min_hole_area_m2 = 5;
+  const auto exact = build_ground_plans(fps, UnionParams{}, problems);
+  ASSERT_EQ(exact.size(), 2u);
+  const auto plans = build_ground_plans(fps, UnionParams{}, lod, problems, {}, nullptr);
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_TRUE(plans[0].polygon.holes.empty());
+  EXPECT_EQ(plans[0].members, (std::vector<std::uint32_t>{0, 1}));
+}
+
 TEST(LodFilters, RasterModeFillsHolesThatHoldNoWholePixel) {
   // Holes 0.9 x 3 m (no 1 m pixel fits, whatever the grid's origin) and 2.5 x 2.5 m (a 1 m pixel
   // always fits): with 1 m pixels only the second stays; with 0.25 m pixels both stay.
