@@ -44,6 +44,7 @@
 #include <string>
 #include <utility>
 
+#include "lod/ring_geometry.h"
 #include "robust/predicates.h"
 
 namespace groundplan {
@@ -58,21 +59,8 @@ struct Vec {
 
 Point2 along(const Point2& p, const Vec& v, double s) { return Point2{p.x + v.x * s, p.y + v.y * s}; }
 
-// Twice the signed area about the ring's first vertex (local differences keep the digits).
-double ring_area2(const Ring& r) {
-  if (r.size() < 3) return 0;
-  const Point2 o = r[0];
-  double s = 0;
-  for (std::size_t i = 1; i + 1 < r.size(); ++i)
-    s += (r[i].x - o.x) * (r[i + 1].y - o.y) - (r[i + 1].x - o.x) * (r[i].y - o.y);
-  return s;
-}
+double ring_area2(const Ring& r) { return static_cast<double>(lod::ring_area2(r)); }
 
-double plan_area(const Polygon& p) {
-  double a = std::abs(ring_area2(p.outer));
-  for (const Ring& h : p.holes) a -= std::abs(ring_area2(h));
-  return a / 2;
-}
 
 // The ring without consecutive repeated points (the closing vertex included).
 Ring without_repeats(const Ring& r) {
@@ -571,8 +559,8 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
 
   if (stats) {
     double before = 0, after = 0;
-    for (const GroundPlan& g : plans) before += plan_area(g.polygon);
-    for (const GroundPlan& g : out) after += plan_area(g.polygon);
+    for (const GroundPlan& g : plans) before += polygon_area(g.polygon);
+    for (const GroundPlan& g : out) after += polygon_area(g.polygon);
     stats->close_plans_before = plans.size();
     stats->close_plans_after = out.size();
     stats->close_area_added_m2 = after - before;

@@ -15,6 +15,7 @@
 #include <limits>
 #include <string>
 
+#include "lod/ring_geometry.h"
 #include "robust/predicates.h"
 
 namespace groundplan {
@@ -25,16 +26,7 @@ double seconds_since(clock_type::time_point t0) {
   return std::chrono::duration<double>(clock_type::now() - t0).count();
 }
 
-/// Twice the signed area of a ring about its first vertex (UTM magnitudes: the differences are exact).
-long double ring_area2(const Ring& r) {
-  if (r.size() < 3) return 0;
-  long double a = 0;
-  const Point2 o = r[0];
-  for (std::size_t i = 1; i + 1 < r.size(); ++i)
-    a += static_cast<long double>(r[i].x - o.x) * (r[i + 1].y - o.y) -
-         static_cast<long double>(r[i + 1].x - o.x) * (r[i].y - o.y);
-  return a;
-}
+using lod::ring_area2;
 
 struct Box {
   double minx = std::numeric_limits<double>::infinity(), miny = minx;

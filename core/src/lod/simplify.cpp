@@ -36,6 +36,7 @@
 #include <utility>
 #include <vector>
 
+#include "lod/ring_geometry.h"
 #include "robust/predicates.h"
 
 namespace groundplan {
@@ -43,15 +44,7 @@ namespace {
 
 using robust::orient;
 
-double seg_dist2(const Point2& p, const Point2& a, const Point2& b) {
-  const double ux = b.x - a.x, uy = b.y - a.y;
-  const double wx = p.x - a.x, wy = p.y - a.y;
-  const double len2 = ux * ux + uy * uy;
-  double t = len2 > 0 ? (wx * ux + wy * uy) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  const double dx = wx - t * ux, dy = wy - t * uy;
-  return dx * dx + dy * dy;
-}
+using lod::segment_distance2;
 
 /// r collinear with p, q: whether it lies on the closed segment p-q (exact: comparisons only).
 bool within_box(const Point2& p, const Point2& q, const Point2& r) {
@@ -217,13 +210,7 @@ struct Edge {
   bool alive = true;
 };
 
-/// Twice the signed area of a ring, about its first vertex.
-double ring_area2(const std::vector<Point2>& r) {
-  double s = 0;
-  for (std::size_t i = 1; i + 1 < r.size(); ++i)
-    s += (r[i].x - r[0].x) * (r[i + 1].y - r[0].y) - (r[i + 1].x - r[0].x) * (r[i].y - r[0].y);
-  return s;
-}
+double ring_area2(const Ring& r) { return static_cast<double>(lod::ring_area2(r)); }
 
 class Simplifier {
  public:
@@ -409,7 +396,7 @@ class Simplifier {
     double far_d2 = -1;
     for (std::size_t i = a + 1; i < b; ++i) {
       const double d2 = pa == pb ? (ring[i % n].x - pa.x) * (ring[i % n].x - pa.x) + (ring[i % n].y - pa.y) * (ring[i % n].y - pa.y)
-                                 : seg_dist2(ring[i % n], pa, pb);
+                                 : segment_distance2(ring[i % n], pa, pb);
       if (d2 > far_d2) far_d2 = d2, far = i;
     }
     // A chain from a point back to itself (a pinched loop) never becomes a zero-length edge.

@@ -32,6 +32,8 @@
 #include <utility>
 #include <vector>
 
+#include "lod/ring_geometry.h"
+
 namespace groundplan {
 namespace {
 
@@ -42,16 +44,7 @@ double dist2(const Point2& a, const Point2& b) {
   return dx * dx + dy * dy;
 }
 
-/// Squared distance from p to the segment a-b (a != b).
-double seg_dist2(const Point2& p, const Point2& a, const Point2& b) {
-  const double ux = b.x - a.x, uy = b.y - a.y;
-  const double wx = p.x - a.x, wy = p.y - a.y;
-  const double len2 = ux * ux + uy * uy;
-  double t = len2 > 0 ? (wx * ux + wy * uy) / len2 : 0;
-  t = std::clamp(t, 0.0, 1.0);
-  const double dx = wx - t * ux, dy = wy - t * uy;
-  return dx * dx + dy * dy;
-}
+using lod::segment_distance2;
 
 /// Open-addressing map from a grid cell to a value (the head of a list, or a range start): much
 /// faster than std::unordered_map for the million lookups of a city.
@@ -306,7 +299,7 @@ std::vector<Footprint> snap_footprints(const std::vector<Footprint>& footprints,
     for (std::uint32_t v : cand) {
       if (v == ia || v == ib) continue;
       const Point2& p = kept[v];
-      if (seg_dist2(p, a, b) <= tol2) hits.emplace_back(((p.x - a.x) * ux + (p.y - a.y) * uy) / len2, v);
+      if (segment_distance2(p, a, b) <= tol2) hits.emplace_back(((p.x - a.x) * ux + (p.y - a.y) * uy) / len2, v);
     }
     std::sort(hits.begin(), hits.end());
   };
