@@ -84,6 +84,8 @@ struct FaceInfo {
 };
 
 struct HalfEdge {
+  HalfEdge() {}  // left uninitialised: resize() for a mesh's half-edges writes nothing
+  HalfEdge(std::uint32_t a_, std::uint32_t b_, std::uint32_t face_, std::int8_t up_) : a(a_), b(b_), face(face_), up(up_) {}
   std::uint32_t a, b;   // welded vertices, boundary orientation of the face as written
   std::uint32_t face;
   /// Whether a wall facet rises from this edge: +1 when the unit in-plane direction into the face
@@ -189,6 +191,7 @@ struct Workspace {
   std::vector<std::uint32_t> he_group, group_count, group_start, group_members, bucket_start;
   std::vector<std::uint32_t> ring_tmp, ring_buf;
   std::vector<std::uint32_t> he_next, he_max;  // group_edges(): chains per smaller vertex
+  std::vector<std::uint32_t> cnt_buf;  // group sizes while grouping (only grows)
   std::vector<V3> comp_lo, comp_hi;
   std::vector<double> comp_vol, comp_area;
   std::vector<V3> comp_net;
@@ -280,7 +283,8 @@ class Decomposer {
     build_faces();
     resolve_duplicates();
     if (stats_->faces_used == 0) return res;
-    group_edges();
+    if (!ws_.dups.empty()) group_edges();  // else grouped in the ring pass, nothing dropped
+    else finish_groups(ng_);
     if (split_t_junctions()) group_edges();
     orient();
     classify();
@@ -306,6 +310,7 @@ class Decomposer {
   static constexpr double kCell = 16;  // weld grid cell, in weld tolerances
   bool grid_ = false;  // weld through the tolerance grid (vertices within tol of each other)
   std::size_t ring_len_ = 0;  // vertices in ring_buf
+  std::uint32_t ng_ = 0;  // groups found by build_face_rings()
   std::size_t ncomp_ = 0;
   double lower_boundary_len_ = 0;  // plan length of all footprint edges (set when chains stay open)
 
@@ -378,26 +383,36 @@ class Decomposer {
     auto& pos = ws_.distinct_pos;
     of.resize(nv);
     pos.clear();
+    static_assert(sizeof(Point3) == 24);
+    const Point3* MV = m_.vertices.data();
+    std::uint32_t* OF = of.data();
+    ExactEntry* XS = X.slots.data();
+    const std::size_t xmask = X.mask;
+    const std::uint32_t xgen = X.gen;
+    constexpr std::uint64_t kExp = 0x7ffULL << 52;  // all ones: infinite or NaN (std::isfinite false)
     for (std::uint32_t vi = 0; vi < nv; ++vi) {
-      const Point3& q = m_.vertices[vi];
-      if (!(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z))) {
-        of[vi] = kBad;
-        continue;
-      }
+      const Point3& q = MV[vi];
       std::uint64_t bx, by, bz;
       std::memcpy(&bx, &q.x, 8), std::memcpy(&by, &q.y, 8), std::memcpy(&bz, &q.z, 8);
-      std::size_t es = bits_hash(bx, by, bz) & X.mask;
-      for (;; es = (es + 1) & X.mask) {
-        const ExactEntry& e = X.slots[es];
-        if (e.gen != X.gen) {
+      if ((bx & kExp) == kExp || (by & kExp) == kExp || (bz & kExp) == kExp) {
+        OF[vi] = kBad;
+        continue;
+      }
+      std::size_t es = bits_hash(bx, by, bz) & xmask;
+      for (;; es = (es + 1) & xmask) {
+        const ExactEntry& e = XS[es];
+        if (e.gen != xgen) {
           const std::uint32_t d = static_cast<std::uint32_t>(pos.size());
-          X.slots[es] = ExactEntry{vi, d, X.gen};
+          XS[es] = ExactEntry{vi, d, xgen};
           pos.push_back(V3{q.x - o_.x, q.y - o_.y, q.z - o_.z});
-          of[vi] = d;
+          OF[vi] = d;
           break;
         }
-        if (std::memcmp(&m_.vertices[e.vertex], &q, sizeof(Point3)) == 0) {
-          of[vi] = e.rep;
+        std::uint64_t ex, ey, ez;  // bit for bit, as memcmp of the three doubles
+        const Point3& r = MV[e.vertex];
+        std::memcpy(&ex, &r.x, 8), std::memcpy(&ey, &r.y, 8), std::memcpy(&ez, &r.z, 8);
+        if (ex == bx && ey == by && ez == bz) {
+          OF[vi] = e.rep;
           break;
         }
       }
@@ -499,51 +514,6 @@ class Decomposer {
       ws_.wpos.push_back(ws_.distinct_pos[d]);  // reserved: data() does not move
     }
     return f;
-  }
-
-  /// welded_ring() into ring_buf (ring_len_ vertices) and, in the same pass, the ring's Newell
-  /// normal and bounding box (repeated vertices add exact zeros to the normal, so it does not
-  /// matter that they are still there).
-  template <bool Grid>
-  bool welded_ring_normal(std::uint32_t r, V3& n, V3& lo, V3& hi) {
-    std::uint32_t* out = ws_.ring_buf.data();
-    std::size_t len = 0;
-    ring_len_ = 0;
-    n = V3{};
-    const std::uint32_t a = m_.ring_offsets[r], b = m_.ring_offsets[r + 1];
-    if (a >= b) return true;
-    const std::uint32_t* idx = m_.indices.data();
-    const std::size_t nv = m_.vertices.size();
-    const V3* W = ws_.wpos.data();  // reserved for every distinct point: welding does not move it
-    V3 first, prev;
-    {
-      const std::uint32_t vi = idx[a];
-      if (vi >= nv) return false;
-      const std::uint32_t w = Grid ? weld_vertex(vi) : weld_apart(vi);
-      if (w == kBad) return false;
-      first = prev = lo = hi = W[w];
-      out[len++] = w;
-    }
-    for (std::uint32_t k = a + 1; k < b; ++k) {
-      const std::uint32_t vi = idx[k];
-      if (vi >= nv) return false;
-      const std::uint32_t w = Grid ? weld_vertex(vi) : weld_apart(vi);
-      if (w == kBad) return false;
-      const V3 p = W[w];
-      n.x += (prev.y - p.y) * (prev.z + p.z);
-      n.y += (prev.z - p.z) * (prev.x + p.x);
-      n.z += (prev.x - p.x) * (prev.y + p.y);
-      lo.x = std::min(lo.x, p.x), lo.y = std::min(lo.y, p.y), lo.z = std::min(lo.z, p.z);
-      hi.x = std::max(hi.x, p.x), hi.y = std::max(hi.y, p.y), hi.z = std::max(hi.z, p.z);
-      prev = p;
-      if (out[len - 1] != w) out[len++] = w;
-    }
-    n.x += (prev.y - first.y) * (prev.z + first.z);
-    n.y += (prev.z - first.z) * (prev.x + first.x);
-    n.z += (prev.x - first.x) * (prev.y + first.y);
-    while (len > 1 && out[len - 1] == out[0]) --len;
-    ring_len_ = len;
-    return true;
   }
 
   // ---- 2. faces and half-edges ------------------------------------------------------------------
@@ -654,58 +624,187 @@ class Decomposer {
     stats_->vertices_welded = ws_.wpos.size();
   }
 
+  /// One pass per ring (outer, then holes) that welds, takes the Newell normal and bounding box
+  /// (repeated vertices add exact zeros to the normal), notes the face for duplicates, and makes the
+  /// boundary-oriented half-edges and groups them by undirected welded edge as they come (groups
+  /// numbered in order of first appearance; the earlier half-edges with the same smaller vertex are
+  /// chained per vertex, a handful). Without the grid a vertex is its distinct point, numbered in
+  /// order of first use. The groups are final unless a face is dropped as a duplicate (then run()
+  /// groups again, group_edges()).
   template <bool Grid>
   void build_face_rings() {
     const std::size_t nrings = m_.ring_count();
-    V3 n, lo, hi, nh, hlo, hhi;
     const MeshFace* MF = m_.faces.data();
     FaceInfo* FI = ws_.faces.data();
     const std::uint32_t nf = static_cast<std::uint32_t>(m_.faces.size());
+    const std::uint32_t* idx = m_.indices.data();
+    const std::uint32_t* ro = m_.ring_offsets.data();
+    const std::size_t nv = m_.vertices.size();
+    const std::size_t npos = ws_.distinct_pos.size();
+    const std::uint32_t* of = ws_.distinct_of.data();
+    std::uint32_t* dw = ws_.distinct_weld.data();
+    const V3* dpos = ws_.distinct_pos.data();
+    if (!Grid) ws_.wpos.resize(npos);  // grid: weld_new() appends (reserved for npos: data() stays)
+    V3* W = ws_.wpos.data();
+    std::uint32_t nw = 0;
+    std::uint32_t* out = ws_.ring_buf.data();
+    const std::size_t maxh = m_.indices.size();
+    ws_.halfedges.resize(maxh);
+    HalfEdge* HE = ws_.halfedges.data();
+    std::uint32_t nh = 0, ng = 0;
+    auto& headv = ws_.bucket_start;
+    headv.assign(npos, kNone);
+    std::uint32_t* head = headv.data();
+    if (ws_.he_next.size() < maxh) ws_.he_next.resize(maxh), ws_.he_max.resize(maxh), ws_.he_group.resize(maxh);
+    if (ws_.cnt_buf.size() < maxh) ws_.cnt_buf.resize(maxh);
+    std::uint32_t* next = ws_.he_next.data();
+    std::uint32_t* hmax = ws_.he_max.data();
+    std::uint32_t* grp = ws_.he_group.data();
+    std::uint32_t* cnt = ws_.cnt_buf.data();
+    // Ring r's welded vertices into out (repeats removed), Newell normal, box.
+    // Welded id of mesh vertex vi (kBad for an index out of range or a non-finite vertex); without
+    // the grid: its distinct point's id, given in order of first use (nwl: ids given so far).
+    auto weld = [&](std::uint32_t vi, std::uint32_t& nwl) -> std::uint32_t {
+      if (vi >= nv) return kBad;
+      if constexpr (Grid) {
+        return weld_vertex(vi);
+      } else {
+        const std::uint32_t d = of[vi];
+        if (d == kBad) return kBad;
+        std::uint32_t w = dw[d];
+        if (w == kNone) dw[d] = w = nwl, W[nwl++] = dpos[d];
+        return w;
+      }
+    };
+    // Accumulators are locals (written out at the end): stores through W, out and dw could alias the
+    // caller's variables and would keep them in memory.
+    auto ring = [&](std::uint32_t r, V3& n_out, V3& lo_out, V3& hi_out, std::size_t& len_out) -> bool {
+      std::size_t len = 0;
+      std::uint32_t nwl = nw;
+      V3 n{}, lo, hi;
+      const std::uint32_t a = ro[r], b = ro[r + 1];
+      bool ok = true;
+      if (a < b) {
+        V3 first, prev;
+        {
+          const std::uint32_t w = weld(idx[a], nwl);
+          if (w == kBad) {
+            len_out = 0;
+            n_out = V3{};
+            return false;
+          }
+          first = prev = lo = hi = W[w];
+          out[len++] = w;
+        }
+        for (std::uint32_t k = a + 1; k < b; ++k) {
+          const std::uint32_t w = weld(idx[k], nwl);
+          if (w == kBad) {
+            ok = false;
+            break;
+          }
+          const V3 p = W[w];
+          n.x += (prev.y - p.y) * (prev.z + p.z);
+          n.y += (prev.z - p.z) * (prev.x + p.x);
+          n.z += (prev.x - p.x) * (prev.y + p.y);
+          lo.x = std::min(lo.x, p.x), lo.y = std::min(lo.y, p.y), lo.z = std::min(lo.z, p.z);
+          hi.x = std::max(hi.x, p.x), hi.y = std::max(hi.y, p.y), hi.z = std::max(hi.z, p.z);
+          prev = p;
+          if (out[len - 1] != w) out[len++] = w;
+        }
+        if (ok) {
+          n.x += (prev.y - first.y) * (prev.z + first.z);
+          n.y += (prev.z - first.z) * (prev.x + first.x);
+          n.z += (prev.x - first.x) * (prev.y + first.y);
+          while (len > 1 && out[len - 1] == out[0]) --len;
+        }
+      }
+      nw = nwl;
+      len_out = len;
+      n_out = n;
+      lo_out = lo;
+      hi_out = hi;
+      return ok;
+    };
+    // The ring's half-edges (reversed for a hole running with the outer ring), each into its group.
+    auto edges = [&](std::uint32_t f, std::size_t k, const V3 n, const double len2, bool wall, bool reverse) {
+      std::uint32_t h = nh, g_n = ng;
+      for (std::size_t i = 0; i < k; ++i) {
+        std::uint32_t a = out[i], b = out[i + 1 < k ? i + 1 : 0];
+        if (reverse) std::swap(a, b);
+        HE[h] = HalfEdge{a, b, f, wall ? rise(W, n, len2, a, b) : std::int8_t{0}};
+        const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        std::uint32_t j = head[lo];
+        while (j != kNone && hmax[j] != hi) j = next[j];
+        std::uint32_t g;
+        if (j == kNone) {
+          g = g_n++;
+          cnt[g] = 1;
+        } else {
+          g = grp[j];
+          ++cnt[g];
+        }
+        grp[h] = g;
+        hmax[h] = hi;
+        next[h] = head[lo];
+        head[lo] = h;
+        ++h;
+      }
+      nh = h;
+      ng = g_n;
+    };
+    V3 n, lo, hi, nh3, hlo, hhi;
+    std::size_t len = 0;
     for (std::uint32_t f = 0; f < nf; ++f) {
       const MeshFace& mf = MF[f];
       FaceInfo& fi = FI[f];
       fi.uf = f;
       if (mf.kind == SurfaceKind::FootPrint || mf.kind == SurfaceKind::RoofEdge) continue;
       if (mf.ring_count == 0 || std::size_t(mf.first_ring) + mf.ring_count > nrings) continue;
-      if (!welded_ring_normal<Grid>(mf.first_ring, n, lo, hi) || ring_len_ < 3) continue;
+      if (!ring(mf.first_ring, n, lo, hi, len) || len < 3) continue;
       const double len2 = dot(n, n);
       if (!(len2 > 1e-24)) continue;  // zero area: no orientation, no class
+      ring_len_ = len;
       note_face(f, mf.ring_count);
       fi.n = n;
       fi.len = std::sqrt(len2);
       fi.net = n;
-      fi.c = ws_.wpos[ws_.ring_buf[0]];
+      fi.c = W[out[0]];
       fi.lo = lo;
       fi.hi = hi;
-      // Walls are within the proxy tolerance of vertical either way up; floor or ceiling waits for
-      // the orientation (classify()). Only walls need to know which of their edges they rise from.
       const bool wall = n.z * n.z < cos2_tol_ * len2;
       fi.cls = wall ? kWall : kFloor;
       ++stats_->faces_used;
-      add_ring_edges(f, n, len2, wall, false);
+      edges(f, len, n, len2, wall, false);
       for (std::uint32_t r = mf.first_ring + 1; r < mf.first_ring + mf.ring_count; ++r) {
-        if (!welded_ring_normal<Grid>(r, nh, hlo, hhi) || ring_len_ < 3) continue;
-        // Holes run against the outer ring so that the face lies on their left; turn those that don't.
-        const bool same = dot(nh, n) > 0;
-        fi.net = same ? fi.net - nh : V3{fi.net.x + nh.x, fi.net.y + nh.y, fi.net.z + nh.z};
-        add_ring_edges(f, n, len2, wall, same);
+        if (!ring(r, nh3, hlo, hhi, len) || len < 3) continue;
+        const bool same = dot(nh3, n) > 0;
+        fi.net = same ? fi.net - nh3 : V3{fi.net.x + nh3.x, fi.net.y + nh3.y, fi.net.z + nh3.z};
+        edges(f, len, n, len2, wall, same);
       }
     }
+    ring_len_ = 0;
+    if (!Grid) ws_.wpos.resize(nw);
+    ws_.halfedges.resize(nh);
+    ng_ = ng;
   }
 
-  void add_ring_edges(std::uint32_t f, const V3& n, double len2, bool wall, bool reverse) {
-    const std::uint32_t* r = ws_.ring_buf.data();
-    const std::size_t k = ring_len_;
-    auto& he = ws_.halfedges;
-    const std::size_t base = he.size();
-    he.resize(base + k);  // reserved for every index: no reallocation
-    HalfEdge* out = he.data() + base;
-    const V3* W = ws_.wpos.data();
-    for (std::size_t i = 0; i < k; ++i) {
-      std::uint32_t a = r[i], b = r[i + 1 < k ? i + 1 : 0];
-      if (reverse) std::swap(a, b);
-      out[i] = HalfEdge{a, b, f, wall ? rise(W, n, len2, a, b) : std::int8_t{0}};
-    }
+  /// Groups from he_group and cnt_buf (ng groups): group_count, group_start, group_members.
+  void finish_groups(std::uint32_t ng) {
+    const std::size_t nh = ws_.halfedges.size();
+    const std::uint32_t* cnt = ws_.cnt_buf.data();
+    ws_.group_count.assign(cnt, cnt + ng);
+    auto& start = ws_.group_start;
+    start.resize(ng + 1);
+    std::uint32_t* st = start.data();
+    st[0] = 0;
+    for (std::size_t g = 0; g < ng; ++g) st[g + 1] = st[g] + cnt[g];
+    auto& cursor = ws_.bucket_start;
+    cursor.assign(start.begin(), start.end() - 1);
+    std::uint32_t* cur = cursor.data();
+    ws_.group_members.resize(nh);
+    std::uint32_t* mem = ws_.group_members.data();
+    const std::uint32_t* grp = ws_.he_group.data();
+    for (std::uint32_t i = 0; i < nh; ++i) mem[cur[grp[i]]++] = i;
   }
 
   /// HalfEdge::up of a wall facet with Newell normal n (|n|^2 = len2) along a -> b: the sign of
