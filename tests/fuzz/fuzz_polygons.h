@@ -40,7 +40,8 @@ inline std::vector<Footprint> decode_footprints(const std::uint8_t* data, std::s
     const std::size_t n = 3 + head % 14;
     const bool with_hole = head & 0x80;
     Footprint f;
-    f.source_id = "f" + std::to_string(fps.size());
+    f.source_id = std::to_string(fps.size());
+    f.source_id.insert(f.source_id.begin(), 'f');  // not "f" + ...: GCC 12 warns falsely (-Wrestrict)
     Polygon poly;
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint8_t x = d.byte(), y = d.byte();
