@@ -37,6 +37,7 @@ struct LodStats {
   // --close-gaps
   std::size_t close_plans_before = 0, close_plans_after = 0;
   double close_area_added_m2 = 0;
+  std::size_t close_plans_failed = 0;      // plans left unclosed because a union inside the closing failed
   // --resolution-mode raster
   std::size_t raster_holes_filled = 0;
   double raster_pixel_m = 0;               // the pixel size used (the automatic one when resolution_m = 0)

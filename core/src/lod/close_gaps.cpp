@@ -351,7 +351,16 @@ bool same_rings(std::vector<Ring> a, std::vector<Ring> b) {
 struct GroupResult {
   std::vector<GroundPlan> plans;
   std::vector<std::uint32_t> first_input;  // per plan: the lowest input plan index inside (output order)
+  bool failed = false;                     // a union failed: the input plans, unclosed
 };
+
+/// The engine reports a block it could not unite as a UNION_FAILED problem (never expected: every
+/// decision is exact). Inside the closing that would silently lose pieces, so it becomes an Error
+/// here and the group falls back to its input plans.
+void throw_if_failed(const std::vector<Problem>& problems, const char* what) {
+  for (const Problem& p : problems)
+    if (p.code == "UNION_FAILED") throw Error(std::string("close-gaps: the union of the ") + what + " failed: " + p.reason);
+}
 
 std::vector<std::uint32_t> merged_members(const std::vector<GroundPlan>& plans, const std::vector<std::uint32_t>& which) {
   std::vector<std::uint32_t> m;
@@ -383,6 +392,7 @@ GroupResult close_group(const std::vector<GroundPlan>& plans, const GroundPlan& 
   add_offset_pieces(P.outer, d, material_left(P.outer, true) ? -1 : +1, cut.polygons);
   for (const Ring& h : P.holes) add_offset_pieces(h, d, material_left(h, false) ? -1 : +1, cut.polygons);
   const std::vector<GroundPlan> outside = build_ground_plans({cut}, one_thread, ignored);
+  throw_if_failed(ignored, "erosion");
 
   // The eroded region: every ring but M's (M's plan is the one reaching x0), reconciled.
   std::vector<Point2> input_vertices;
@@ -421,6 +431,7 @@ GroupResult close_group(const std::vector<GroundPlan>& plans, const GroundPlan& 
     fps.push_back(Footprint{{std::move(e)}, {}, {}, {}, 0, 0});
   }
   std::vector<GroundPlan> united = build_ground_plans(fps, one_thread, ignored);
+  throw_if_failed(ignored, "closing with its input");
   std::vector<char> placed(group.size(), 0);
   for (GroundPlan& g : united) {
     std::vector<std::uint32_t> inside;
@@ -527,6 +538,19 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
   grown.shrink_to_fit();
   for (GroundPlan& g : dilated)
     for (std::uint32_t& m : g.members) m = grown_plan[m];  // ascending still: grown_plan is
+  std::size_t failed = 0;
+  {
+    // A block of the dilation that failed (UNION_FAILED) left its input plans in no dilated plan:
+    // they pass through unclosed, counted, rather than being lost.
+    std::vector<char> in_dilated(plans.size(), 0);
+    for (const GroundPlan& g : dilated)
+      for (std::uint32_t m : g.members) in_dilated[m] = 1;
+    for (std::uint32_t i : grown_plan)
+      if (!in_dilated[i]) {
+        tagged.emplace_back(i, plans[i]);
+        ++failed;
+      }
+  }
 
   // Erode and reconcile each dilated plan on its own, the largest first.
   std::vector<GroupResult> results(dilated.size());
@@ -535,7 +559,17 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return dilated[a].polygon.outer.size() > dilated[b].polygon.outer.size();
   });
-  auto one = [&](std::size_t oi) { results[order[oi]] = close_group(plans, dilated[order[oi]], d, eps); };
+  auto one = [&](std::size_t oi) {
+    const GroundPlan& g = dilated[order[oi]];
+    try {
+      results[order[oi]] = close_group(plans, g, d, eps);
+    } catch (const Error&) {
+      GroupResult r;
+      r.failed = true;
+      for (std::uint32_t i : g.members) r.plans.push_back(plans[i]), r.first_input.push_back(i);
+      results[order[oi]] = std::move(r);
+    }
+  };
   const int threads = union_params.threads > 0 ? union_params.threads : tbb::this_task_arena::max_concurrency();
   if (threads == 1 || dilated.size() <= 1) {
     for (std::size_t oi = 0; oi < order.size(); ++oi) one(oi);
@@ -550,8 +584,10 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
   }
 
   // Output in the order of the input plans (by the first input plan each result contains).
-  for (GroupResult& r : results)
+  for (GroupResult& r : results) {
+    failed += r.failed ? r.plans.size() : 0;
     for (std::size_t j = 0; j < r.plans.size(); ++j) tagged.emplace_back(r.first_input[j], std::move(r.plans[j]));
+  }
   std::stable_sort(tagged.begin(), tagged.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<GroundPlan> out;
   out.reserve(tagged.size());
@@ -564,6 +600,7 @@ std::vector<GroundPlan> close_gaps(const std::vector<GroundPlan>& plans, double 
     stats->close_plans_before = plans.size();
     stats->close_plans_after = out.size();
     stats->close_area_added_m2 = after - before;
+    stats->close_plans_failed = failed;
     stats->close_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return out;

@@ -272,6 +272,11 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     const auto t0 = clock_type::now();
     plans = close_gaps(plans, lod.close_gaps_m, union_params, &st);
     st.close_s = seconds_since(t0);
+    if (st.close_plans_failed)
+      problems.push_back(Problem{"", "", "lod", "CLOSE_GAPS_FAILED",
+                                 std::to_string(st.close_plans_failed) +
+                                     " plan(s) are written without --close-gaps: the union inside the closing "
+                                     "failed on them (please report the input)"});
     progress.report(0.85, "closing gaps");
   }
   // 4. The paper's level of detail: holes the raster cannot see.
