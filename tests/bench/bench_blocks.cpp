@@ -11,7 +11,6 @@
 #include <groundplan/error.h>
 #include <groundplan/raster_backend.h>
 
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -23,6 +22,7 @@
 #include <vector>
 
 #include "blocks/cpu_raster_backend.h"
+#include "bench_util.h"
 #include "union_generators.h"
 
 namespace {
@@ -30,11 +30,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-double peak_rss_mib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
+using groundplan::bench::peak_rss_mib;
 
 bool same_blocks(const std::vector<groundplan::Block>& a, const std::vector<groundplan::Block>& b) {
   if (a.size() != b.size()) return false;

@@ -13,7 +13,6 @@
 #include <groundplan/ground_plans.h>
 
 #include <geos_c.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -23,22 +22,14 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "union_generators.h"
 
 namespace {
 
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
 
-double peak_rss_mib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
+using groundplan::bench::cpu_seconds;
+using groundplan::bench::peak_rss_mib;
 
 void quiet(const char*, ...) {}
 

@@ -790,9 +790,15 @@ class Decomposer {
 
   /// Groups from he_group and cnt_buf (ng groups): group_count, group_start, group_members.
   void finish_groups(std::uint32_t ng) {
-    const std::size_t nh = ws_.halfedges.size();
     const std::uint32_t* cnt = ws_.cnt_buf.data();
     ws_.group_count.assign(cnt, cnt + ng);
+    sort_group_members(ng);
+  }
+
+  /// group_start and group_members (counting sort of the half-edges by he_group) from group_count.
+  void sort_group_members(std::uint32_t ng) {
+    const std::size_t nh = ws_.halfedges.size();
+    const std::uint32_t* cnt = ws_.group_count.data();
     auto& start = ws_.group_start;
     start.resize(ng + 1);
     std::uint32_t* st = start.data();
@@ -806,6 +812,7 @@ class Decomposer {
     const std::uint32_t* grp = ws_.he_group.data();
     for (std::uint32_t i = 0; i < nh; ++i) mem[cur[grp[i]]++] = i;
   }
+
 
   /// HalfEdge::up of a wall facet with Newell normal n (|n|^2 = len2) along a -> b: the sign of
   /// (n x d).z / (|n| |d|) beyond +-kRise, decided on squares (no square root, no division).
@@ -854,17 +861,7 @@ class Decomposer {
       H0[lo] = i;
     }
     count.resize(ng);
-    auto& start = ws_.group_start;
-    start.resize(ng + 1);
-    std::uint32_t* st = start.data();
-    st[0] = 0;
-    for (std::size_t g = 0; g < ng; ++g) st[g + 1] = st[g] + cnt[g];
-    auto& cursor = ws_.bucket_start;
-    cursor.assign(start.begin(), start.end() - 1);
-    std::uint32_t* cur = cursor.data();
-    ws_.group_members.resize(nh);
-    std::uint32_t* mem = ws_.group_members.data();
-    for (std::uint32_t i = 0; i < nh; ++i) mem[cur[grp[i]]++] = i;
+    sort_group_members(ng);
   }
 
   // ---- T-junctions ------------------------------------------------------------------------------

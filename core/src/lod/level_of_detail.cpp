@@ -106,17 +106,32 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-/// Fills the holes of `plans` for which `fill(plan, hole)` says so. A plan inside a filled hole (an
+/// The plans' outer-ring boxes sorted by their left edge: the plans whose box lies inside a given box
+/// (a hole's: its candidate islands) are found by a range scan.
+struct PlanIndex {
+  std::vector<Box> boxes;
+  std::vector<std::size_t> by_minx;
+  explicit PlanIndex(const std::vector<GroundPlan>& plans) : boxes(plans.size()), by_minx(plans.size()) {
+    for (std::size_t i = 0; i < plans.size(); ++i) boxes[i] = ring_box(plans[i].polygon.outer), by_minx[i] = i;
+    std::sort(by_minx.begin(), by_minx.end(), [&](std::size_t a, std::size_t b) { return boxes[a].minx < boxes[b].minx; });
+  }
+  /// Calls f(j) for every plan j whose box lies inside `b`.
+  template <class F>
+  void for_each_inside(const Box& b, const F& f) const {
+    auto it = std::lower_bound(by_minx.begin(), by_minx.end(), b.minx,
+                               [&](std::size_t i, double x) { return boxes[i].minx < x; });
+    for (; it != by_minx.end() && boxes[*it].minx <= b.maxx; ++it)
+      if (b.contains(boxes[*it])) f(*it);
+  }
+};
+
+/// Fills the holes of `plans` for which `fill(plan, hole, index)` says so. A plan inside a filled hole (an
 /// island) would now overlap its owner: it joins the owner (members merged), so the plans stay
 /// non-overlapping. Returns the number of holes filled and adds their area to *area.
 template <class Fill>
 std::size_t fill_holes(std::vector<GroundPlan>& plans, const Fill& fill, const std::vector<Footprint>& footprints,
                        std::vector<Problem>& problems, const char* code, const std::string& why, double* area) {
-  // Plans by the left edge of their outer ring's box: the islands of a hole are found by a range scan.
-  std::vector<Box> boxes(plans.size());
-  std::vector<std::size_t> by_minx(plans.size());
-  for (std::size_t i = 0; i < plans.size(); ++i) boxes[i] = ring_box(plans[i].polygon.outer), by_minx[i] = i;
-  std::sort(by_minx.begin(), by_minx.end(), [&](std::size_t a, std::size_t b) { return boxes[a].minx < boxes[b].minx; });
+  const PlanIndex index(plans);
   std::vector<char> absorbed(plans.size(), 0);
   std::size_t filled = 0;
   for (std::size_t pi = 0; pi < plans.size(); ++pi) {
@@ -124,7 +139,7 @@ std::size_t fill_holes(std::vector<GroundPlan>& plans, const Fill& fill, const s
     GroundPlan& g = plans[pi];
     std::vector<Ring> kept;
     for (Ring& h : g.polygon.holes) {
-      if (!fill(g, h)) {
+      if (!fill(g, h, index)) {
         kept.push_back(std::move(h));
         continue;
       }
@@ -132,20 +147,16 @@ std::size_t fill_holes(std::vector<GroundPlan>& plans, const Fill& fill, const s
       const double a = static_cast<double>(std::fabs(ring_area2(h)) / 2);
       *area += a;
       const Box hb = ring_box(h);
-      auto it = std::lower_bound(by_minx.begin(), by_minx.end(), hb.minx,
-                                 [&](std::size_t i, double x) { return boxes[i].minx < x; });
       std::size_t islands = 0;
-      for (; it != by_minx.end() && boxes[*it].minx <= hb.maxx; ++it) {
-        const std::size_t j = *it;
-        if (j == pi || absorbed[j] || !hb.contains(boxes[j])) continue;
-        if (!ring_inside(plans[j].polygon.outer, h)) continue;
+      index.for_each_inside(hb, [&](std::size_t j) {
+        if (j == pi || absorbed[j] || !ring_inside(plans[j].polygon.outer, h)) return;
         absorbed[j] = 1;
         ++islands;
         std::vector<std::uint32_t> merged;
         std::set_union(g.members.begin(), g.members.end(), plans[j].members.begin(), plans[j].members.end(),
                        std::back_inserter(merged));
         g.members = std::move(merged);
-      }
+      });
       Point2 c = h[0];
       const std::string file =
           !g.members.empty() && g.members[0] < footprints.size() ? footprints[g.members[0]].source_file : "";
@@ -295,19 +306,11 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
       if (std::isfinite(smallest)) grid.resolution_m = std::sqrt(smallest / 4);
     }
     st.raster_pixel_m = grid.resolution_m;
-    // Candidate islands of a hole: plans whose box lies in the hole's box (found per hole below).
-    std::vector<Box> boxes(plans.size());
-    std::vector<std::size_t> by_minx(plans.size());
-    for (std::size_t i = 0; i < plans.size(); ++i) boxes[i] = ring_box(plans[i].polygon.outer), by_minx[i] = i;
-    std::sort(by_minx.begin(), by_minx.end(),
-              [&](std::size_t a, std::size_t b) { return boxes[a].minx < boxes[b].minx; });
-    auto fill = [&](const GroundPlan& owner, const Ring& h) {
-      const Box hb = ring_box(h);
-      std::vector<const GroundPlan*> near;
-      auto it = std::lower_bound(by_minx.begin(), by_minx.end(), hb.minx,
-                                 [&](std::size_t i, double x) { return boxes[i].minx < x; });
-      for (; it != by_minx.end() && boxes[*it].minx <= hb.maxx; ++it)
-        if (&plans[*it] != &owner && hb.contains(boxes[*it])) near.push_back(&plans[*it]);
+    auto fill = [&](const GroundPlan& owner, const Ring& h, const PlanIndex& index) {
+      std::vector<const GroundPlan*> near;  // candidate islands: plans whose box lies in the hole's
+      index.for_each_inside(ring_box(h), [&](std::size_t j) {
+        if (&plans[j] != &owner) near.push_back(&plans[j]);
+      });
       return !hole_holds_a_pixel(h, near, grid);
     };
     double area = 0;
@@ -328,7 +331,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   const auto t_filter = clock_type::now();
   if (lod.min_hole_area_m2 > 0) {
     const double a_min = lod.min_hole_area_m2;
-    auto fill = [&](const GroundPlan&, const Ring& h) { return std::fabs(ring_area2(h)) / 2 < a_min; };
+    auto fill = [&](const GroundPlan&, const Ring& h, const PlanIndex&) { return std::fabs(ring_area2(h)) / 2 < a_min; };
     st.holes_filled += fill_holes(plans, fill, footprints, problems, "HOLE_BELOW_MIN_AREA",
                                   "smaller than --min-hole-area " + fmt("%g", a_min) + " m2", &st.holes_filled_area_m2);
   }
