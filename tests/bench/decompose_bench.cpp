@@ -10,6 +10,8 @@
 // file, a hash of every decomposition's polygons (coordinate bits), stats and surface decomposition:
 // a change that must not alter results is checked by comparing this output before and after.
 // `--check-variants` hashes perturbed copies of every mesh too (weld tolerance, T-junctions, shadow).
+// `--dump OUT [file ...]` writes the meshes it would time (same default files, GroundSurfaces removed)
+// to OUT for decompose_replay, which times them on a machine without the GIS libraries.
 #include "footprint/decompose.h"
 
 #include <groundplan/footprint.h>
@@ -27,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "decompose_dump.h"
 #include "test_config.h"
 #include "test_support.h"
 
@@ -252,10 +255,15 @@ int check(int argc, char** argv, int first) {
 int main(int argc, char** argv) {
   std::vector<std::pair<std::string, bool>> files;
   int first = 1;
+  std::string dump;
   if (argc > 1 && std::string(argv[1]) == "--check") return check(argc, argv, 2);
   if (argc > 1 && std::string(argv[1]) == "--check-variants") return g_variants = true, check(argc, argv, 2);
   if (argc > 2 && std::string(argv[1]) == "--passes") {
     g_passes = std::max(1, std::atoi(argv[2]));
+    first = 3;
+  }
+  if (argc > 2 && std::string(argv[1]) == "--dump") {
+    dump = argv[2];
     first = 3;
   }
   if (argc > first) {
@@ -274,12 +282,24 @@ int main(int argc, char** argv) {
     files.emplace_back(d + "/citygml1-niedersachsen-lod1-4tiles/LoD1_24065860_2_2021-01-25.gml", false);
     files.emplace_back(d + "/citygml2-plateau-japan-lod1/53395404_bldg_6697_op.gml", false);
   }
+  std::vector<bench::MeshSet> sets;
   for (const auto& [path, ground_only] : files) {
     try {
-      run(load(path, ground_only));
+      Set s = load(path, ground_only);
+      if (dump.empty()) run(s);
+      else if (!s.bare.empty()) sets.push_back(bench::MeshSet{s.name, std::move(s.bare)});
     } catch (const std::exception& e) {
       std::fprintf(stderr, "%s: %s\n", path.c_str(), e.what());
     }
+  }
+  if (!dump.empty()) {
+    if (!bench::write_mesh_sets(dump, sets)) {
+      std::fprintf(stderr, "%s: cannot write\n", dump.c_str());
+      return 1;
+    }
+    for (const bench::MeshSet& s : sets)
+      std::printf("%-58s %6zu meshes  result hash %016llx\n", s.name.c_str(), s.meshes.size(),
+                  static_cast<unsigned long long>(bench::decompose_hash(s.meshes)));
   }
   return 0;
 }

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: MIT
+// Footprints per second by surface decomposition (issue 5) on meshes from a dump written by
+// `decompose_bench --dump FILE`, so the figure can be taken on machines without the GIS libraries.
+// Links only the decomposition (and the union engine for the shadow fallback; where that is not
+// built, decompose_replay_no_union.cpp stands in and says so, and meshes that would take the shadow
+// give other results: their count is printed).
+//
+// Usage: decompose_replay DUMP [--threads N]
+//   one thread: per set, the median of >= 5 passes over >= 0.5 s, as decompose_bench times it;
+//   --threads N: N threads decompose the same set at once for ~1 s each; per-thread throughput
+//   (the per-core figure with every core busy) and the total.
+// The result hash printed per set is decompose_hash(): equal to what decompose_bench --dump
+// printed for the same dump when this machine computed the same footprints bit for bit.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "decompose_dump.h"
+
+namespace {
+using namespace groundplan;
+using Clock = std::chrono::steady_clock;
+
+double median_seconds(const std::vector<Mesh>& ms) {
+  std::vector<double> t;
+  double spent = 0;
+  std::size_t sink = 0;
+  while (spent < 0.5 || t.size() < 5) {
+    const auto t0 = Clock::now();
+    for (const Mesh& m : ms) sink += footprint::decompose_footprint(m).polygons.size();
+    t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+    spent += t.back();
+  }
+  if (sink == 0xFFFFFFFF) std::puts("");  // keeps the work observable
+  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+  return t[t.size() / 2];
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: decompose_replay DUMP [--threads N]\n");
+    return 2;
+  }
+  int threads = 0;
+  for (int i = 2; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--threads") threads = std::max(1, std::atoi(argv[i + 1]));
+  std::vector<bench::MeshSet> sets;
+  if (!bench::read_mesh_sets(argv[1], sets)) {
+    std::fprintf(stderr, "%s: not a mesh dump of this version, or cut short\n", argv[1]);
+    return 1;
+  }
+  for (const bench::MeshSet& s : sets) {
+    std::size_t shadow = 0, faces = 0;
+    for (const Mesh& m : s.meshes) shadow += footprint::decompose_footprint(m).stats.shadow, faces += m.faces.size();
+    const double n = static_cast<double>(s.meshes.size());
+    const double sec = median_seconds(s.meshes);
+    std::printf("%-58s %6zu bldg %7.1f faces/bldg  decompose %9.0f bldg/s (%7.2f us)  shadow %zu  result hash %016llx\n",
+                s.name.c_str(), s.meshes.size(), faces / n, n / sec, 1e6 * sec / n, shadow,
+                static_cast<unsigned long long>(bench::decompose_hash(s.meshes)));
+  }
+  if (threads > 0) {
+    std::printf("-- %d threads at once, each decomposing the whole set repeatedly for ~1 s\n", threads);
+    for (const bench::MeshSet& s : sets) {
+      std::vector<double> rate(threads);
+      std::atomic<int> ready{0};
+      std::vector<std::thread> pool;
+      for (int t = 0; t < threads; ++t)
+        pool.emplace_back([&, t] {
+          ++ready;
+          while (ready.load() < threads) std::this_thread::yield();
+          std::size_t done = 0, sink = 0;
+          const auto t0 = Clock::now();
+          double sec = 0;
+          while (sec < 1.0) {
+            for (const Mesh& m : s.meshes) sink += footprint::decompose_footprint(m).polygons.size();
+            done += s.meshes.size();
+            sec = std::chrono::duration<double>(Clock::now() - t0).count();
+          }
+          rate[t] = done / sec + (sink == 0xFFFFFFFF);
+        });
+      for (auto& th : pool) th.join();
+      std::vector<double> r = rate;
+      std::sort(r.begin(), r.end());
+      double total = 0;
+      for (double v : r) total += v;
+      std::printf("%-58s per thread median %9.0f bldg/s [min %9.0f, max %9.0f]  total %10.0f bldg/s\n", s.name.c_str(),
+                  r[r.size() / 2], r.front(), r.back(), total);
+    }
+  }
+  return 0;
+}
