@@ -28,7 +28,7 @@ for s in $srcs tests/bench/decompose_replay.cpp; do
 done
 wait $pids  # not a bare wait: that would wait for the tee above too, forever
 g++ $objs $libs -pthread -o $B/decompose_replay || { echo "build failed"; exit 1; }
-echo "== one thread (median of >= 5 passes), then every core at once"
-$B/decompose_replay "$DUMP" --threads "$(nproc)"
+echo "== one thread (median of >= 5 passes), by size, then every core at once"
+$B/decompose_replay "$DUMP" --by-size --threads "$(nproc)"
 echo "== one thread again (noise check)"
 $B/decompose_replay "$DUMP"
