@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The one place that chooses a raster backend and the only #ifdef GROUNDPLAN_HAVE_CUDA (STYLE.md
 // §6). Cuda: the CUDA backend, or GpuError when it is not built in or no device answers. Auto: CUDA
-// when it is built in and a device answers, else CPU. Both give the same blocks and seeds.
+// when it is built in, a device answers and the work is large enough to pay for starting it
+// (kCudaAutoMinFootprints), else CPU. Both give the same blocks and seeds.
 #include <groundplan/error.h>
 #include <groundplan/raster_backend.h>
 
@@ -12,7 +13,7 @@
 
 namespace groundplan {
 
-std::unique_ptr<RasterBackend> make_raster_backend(Device requested) {
+std::unique_ptr<RasterBackend> make_raster_backend(Device requested, [[maybe_unused]] std::size_t footprints) {
   switch (requested) {
     case Device::Cuda:
 #ifdef GROUNDPLAN_HAVE_CUDA
@@ -22,7 +23,7 @@ std::unique_ptr<RasterBackend> make_raster_backend(Device requested) {
 #endif
     case Device::Auto:
 #ifdef GROUNDPLAN_HAVE_CUDA
-      if (detail::cuda_device_count() > 0) {
+      if (footprints >= kCudaAutoMinFootprints && detail::cuda_device_count() > 0) {
         try {
           return detail::make_cuda_raster_backend();
         } catch (const GpuError&) {

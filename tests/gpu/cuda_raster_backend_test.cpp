@@ -75,6 +75,18 @@ void expect_same(RasterBackend& gpu, const std::vector<Footprint>& fps, double r
   }
 }
 
+// Auto takes the GPU only when the work pays for starting CUDA (kCudaAutoMinFootprints); an
+// explicit Cuda always does. The pipeline's default is Auto, so a small city on a GPU host must not
+// wait ~0.3 s for a context it does not need.
+TEST(CudaRasterBackend, AutoTakesTheGpuOnlyForLargeInputs) {
+  REQUIRE_CUDA(gpu);
+  EXPECT_STREQ(gpu->name(), "cuda");
+  EXPECT_STREQ(make_raster_backend(Device::Auto, 1000)->name(), "cpu");
+  EXPECT_STREQ(make_raster_backend(Device::Auto, kCudaAutoMinFootprints - 1)->name(), "cpu");
+  EXPECT_STREQ(make_raster_backend(Device::Auto, kCudaAutoMinFootprints)->name(), "cuda");
+  EXPECT_STREQ(make_raster_backend(Device::Cuda, 1000)->name(), "cuda");
+}
+
 TEST(CudaRasterBackend, SameAsCpuOnSyntheticCities) {
   REQUIRE_CUDA(gpu);
   for (std::size_t n : {1u, 10u, 600u, 6000u, 100000u})

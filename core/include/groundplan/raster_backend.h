@@ -12,6 +12,7 @@
 #include <groundplan/progress.h>
 #include <groundplan/types.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -73,7 +74,14 @@ FootprintSet make_footprint_set(const std::vector<Footprint>& footprints);
 /// average: the raster only finds blocks, so a coarser one costs no exactness.
 PixelGrid make_pixel_grid(const FootprintSet& fps, double resolution_m);
 
-/// Auto and Cpu give the CPU backend; Cuda throws GpuError until the CUDA backend exists (issue 4).
-std::unique_ptr<RasterBackend> make_raster_backend(Device requested);
+/// Device::Auto takes the GPU only for at least this many footprints. Starting CUDA costs 0.22-0.35 s
+/// (an H100 host, tests/bench/RESULTS.md), while the CPU finds blocks at ~0.8-1.2 us a footprint and
+/// the GPU at ~0.04: the GPU pays for its start from about 300k-400k footprints on 1-2 cores.
+inline constexpr std::size_t kCudaAutoMinFootprints = 500000;
+
+/// Cpu: the CPU backend. Cuda: the CUDA backend, or GpuError when it is not built in or no device
+/// answers. Auto: CUDA when it is built in, a device answers and `footprints` (the size of the work)
+/// is at least kCudaAutoMinFootprints, else the CPU. Every backend gives the same blocks and seeds.
+std::unique_ptr<RasterBackend> make_raster_backend(Device requested, std::size_t footprints = SIZE_MAX);
 
 }  // namespace groundplan

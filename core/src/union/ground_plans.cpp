@@ -59,8 +59,6 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   if (params.resolution_m < 0 || !std::isfinite(params.resolution_m))
     throw InvalidArgument("resolution_m must be >= 0 (0 = automatic), got " + std::to_string(params.resolution_m));
   if (params.threads < 0) throw InvalidArgument("threads must be >= 0 (0 = all cores)");
-  std::unique_ptr<RasterBackend> backend = make_raster_backend(params.device);
-
   // Footprints without area take no part; each is reported (nothing is dropped silently).
   std::vector<Footprint> const* src = &footprints;
   std::vector<char> usable(footprints.size(), 0);
@@ -79,6 +77,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     fps.boxes.push_back(all.boxes[k]);
   }
   const PixelGrid grid = make_pixel_grid(fps, params.resolution_m);
+  std::unique_ptr<RasterBackend> backend = make_raster_backend(params.device, fps.indices.size());
   const auto t_blocks = std::chrono::steady_clock::now();
   std::vector<Block> blocks = backend->find_blocks(fps, grid, progress.sub(0.0, 0.1));
   const auto t_union = std::chrono::steady_clock::now();

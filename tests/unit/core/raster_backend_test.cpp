@@ -98,6 +98,8 @@ TEST(RasterBackend, CpuIsCpuAutoIsCudaOnlyWithADeviceCudaIsCudaOrAGpuError) {
     EXPECT_STREQ(cuda->name(), "cuda");
   }
   EXPECT_STREQ(make_raster_backend(Device::Auto)->name(), cuda ? "cuda" : "cpu");
+  // Below kCudaAutoMinFootprints, Auto is the CPU even with a device (tests/gpu checks with one).
+  EXPECT_STREQ(make_raster_backend(Device::Auto, kCudaAutoMinFootprints - 1)->name(), "cpu");
 }
 
 // City scale: rows are processed in bands of bounded keys; components crossing band edges are

@@ -1,0 +1,23 @@
+#!/bin/bash
+# Packs a CUDA-enabled `groundplan` CLI with the shared libraries it needs (all but the C and C++
+# runtimes, which the target has in newer versions) and GDAL's and PROJ's data into one .tar.xz, so
+# the end-to-end run (tests/gpu/e2e_on_gpu.sh) can happen on a GPU host that has no GDAL, GEOS or
+# PROJ packages. Real inputs go in as well (data/). Usage, from the repository root:
+#   tests/gpu/pack_cli.sh BUILD_DIR OUT.tar.xz INPUT...
+set -eu
+BUILD=${1:?BUILD_DIR}; OUTF=${2:?OUT.tar.xz}; shift 2
+T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
+mkdir -p "$T/gp/bin" "$T/gp/lib" "$T/gp/share" "$T/gp/data"
+cp "$BUILD/bin/groundplan" "$T/gp/bin/"
+ldd "$BUILD/bin/groundplan" | awk '$3 ~ /^\// {print $3}' | while read -r lib; do
+  case "$(basename "$lib")" in
+    libc.so*|libm.so*|libstdc++.so*|libgcc_s.so*|ld-linux*|libpthread.so*|libdl.so*|librt.so*|libcuda.so*) ;;
+    *) cp -L "$lib" "$T/gp/lib/" ;;
+  esac
+done
+cp -r /usr/share/gdal "$T/gp/share/gdal"
+mkdir -p "$T/gp/share/proj" && cp /usr/share/proj/proj.db "$T/gp/share/proj/"
+for f in "$@"; do cp -r "$f" "$T/gp/data/"; done
+du -sh "$T/gp"
+tar -C "$T" -cf - gp | xz -T2 -6 > "$OUTF"
+ls -la "$OUTF"
