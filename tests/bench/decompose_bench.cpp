@@ -66,14 +66,14 @@ Set load(const std::string& path, bool ground_only) {
   Set s;
   s.name = fs::path(path).filename().string();
   std::vector<Problem> problems;
-  gis::SourceInfo info;
+  gis::ReadInfo info;
   std::vector<Mesh> meshes;
-  gis::read_citygml(path, {}, [&](Mesh&& m) { meshes.push_back(std::move(m)); }, problems, info);
-  std::unique_ptr<gis::WorkingFrame> frame;
-  try {
-    frame = std::make_unique<gis::WorkingFrame>(info.srs_name, gis::CrsOptions{}, path);
-  } catch (const std::exception&) {
-  }
+  gis::read_any(path, {}, [&](Mesh&& m) { meshes.push_back(std::move(m)); }, problems, info);
+  std::unique_ptr<gis::WorkingFrame> frame;  // CityGML: as written; KML, COLLADA, glTF arrive placed
+  if (!info.in_working_crs) try {
+      frame = std::make_unique<gis::WorkingFrame>(info.citygml.srs_name, gis::CrsOptions{}, path);
+    } catch (const std::exception&) {
+    }
   for (Mesh& m : meshes) {
     const bool ground = std::any_of(m.faces.begin(), m.faces.end(), [](const MeshFace& f) { return f.kind == SurfaceKind::Ground; });
     if (ground_only && !ground) continue;
@@ -281,6 +281,10 @@ int main(int argc, char** argv) {
     // LoD1 solids without GroundSurface: the decomposition on whole tiles.
     files.emplace_back(d + "/citygml1-niedersachsen-lod1-4tiles/LoD1_24065860_2_2021-01-25.gml", false);
     files.emplace_back(d + "/citygml2-plateau-japan-lod1/53395404_bldg_6697_op.gml", false);
+    // COLLADA placed by KML (SketchUp export, no ground): the decomposition is the only way there.
+    files.emplace_back(d + "/kml-collada-macky-google/macky-normal.kmz", false);
+    for (const char* k : {"a_bd001.kml", "a_bd002.kml", "a_bd003.kml"})
+      files.emplace_back(d + "/kml-collada-korea-mago/sample-kml/" + k, false);
   }
   std::vector<bench::MeshSet> sets;
   for (const auto& [path, ground_only] : files) {

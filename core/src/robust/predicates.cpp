@@ -72,39 +72,56 @@ inline DD dd_sub(DD a, DD b) {
 }
 
 // ---- MPFR, exact: every operation's ternary value must be 0, else retry with more bits ----------
-class Mp {
- public:
-  explicit Mp(mpfr_prec_t prec) { mpfr_init2(v_, prec); }
-  ~Mp() { mpfr_clear(v_); }
-  Mp(const Mp&) = delete;
-  Mp& operator=(const Mp&) = delete;
-  mpfr_ptr get() { return v_; }
-  mpfr_srcptr get() const { return v_; }
+constexpr mpfr_prec_t kMpPrecisions[] = {128, 512, 2200, 8800};  // 2200 bits cover any difference of doubles
+constexpr int kMpLevels = 4;
 
- private:
-  mpfr_t v_;
+/// The MPFR numbers of one precision level, made once per thread: degenerate inputs (many exact
+/// ties, e.g. the shadow of a triangulated model) reach this rung millions of times, and making and
+/// freeing the numbers for each call cost a third of the time. Same precisions as made per call.
+struct MpLevel {
+  bool ready = false;
+  mpfr_t dx1, dy1, dx2, dy2, t1, t2;  // mp_cross(): prec, prec, prec, prec, 2 prec, 2 prec
+  mpfr_t o[4];                        // cross products: 2 prec + 2
+  mpfr_t p1, p2, num;                 // products of those: 2 (2 prec + 2), and their difference (+ 2)
+  void make(mpfr_prec_t prec) {
+    for (mpfr_ptr v : {dx1, dy1, dx2, dy2}) mpfr_init2(v, prec);
+    for (mpfr_ptr v : {t1, t2}) mpfr_init2(v, 2 * prec);
+    const mpfr_prec_t po = 2 * prec + 2;
+    for (mpfr_ptr v : o) mpfr_init2(v, po);
+    for (mpfr_ptr v : {p1, p2}) mpfr_init2(v, 2 * po);
+    mpfr_init2(num, 2 * po + 2);
+    ready = true;
+  }
+  ~MpLevel() {
+    if (!ready) return;
+    for (mpfr_ptr v : {dx1, dy1, dx2, dy2, t1, t2, o[0], o[1], o[2], o[3], p1, p2, num}) mpfr_clear(v);
+  }
 };
 
-/// (p1 - p0) x (q1 - q0) into out (precision >= 2 prec + 2); false if any step was inexact.
-bool mp_cross(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1, mpfr_prec_t prec, Mp& out) {
-  Mp dx1(prec), dy1(prec), dx2(prec), dy2(prec), t1(2 * prec), t2(2 * prec);
+MpLevel& mp_level(int i) {
+  thread_local MpLevel levels[kMpLevels];
+  MpLevel& l = levels[i];
+  if (!l.ready) l.make(kMpPrecisions[i]);
+  return l;
+}
+
+/// (p1 - p0) x (q1 - q0) into out (of level L's precision 2 prec + 2); false if any step was inexact.
+bool mp_cross(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1, MpLevel& L, mpfr_ptr out) {
   int inexact = 0;
-  inexact |= mpfr_set_d(dx1.get(), p1.x, MPFR_RNDN) | mpfr_sub_d(dx1.get(), dx1.get(), p0.x, MPFR_RNDN);
-  inexact |= mpfr_set_d(dy1.get(), p1.y, MPFR_RNDN) | mpfr_sub_d(dy1.get(), dy1.get(), p0.y, MPFR_RNDN);
-  inexact |= mpfr_set_d(dx2.get(), q1.x, MPFR_RNDN) | mpfr_sub_d(dx2.get(), dx2.get(), q0.x, MPFR_RNDN);
-  inexact |= mpfr_set_d(dy2.get(), q1.y, MPFR_RNDN) | mpfr_sub_d(dy2.get(), dy2.get(), q0.y, MPFR_RNDN);
-  inexact |= mpfr_mul(t1.get(), dx1.get(), dy2.get(), MPFR_RNDN);
-  inexact |= mpfr_mul(t2.get(), dy1.get(), dx2.get(), MPFR_RNDN);
-  inexact |= mpfr_sub(out.get(), t1.get(), t2.get(), MPFR_RNDN);
+  inexact |= mpfr_set_d(L.dx1, p1.x, MPFR_RNDN) | mpfr_sub_d(L.dx1, L.dx1, p0.x, MPFR_RNDN);
+  inexact |= mpfr_set_d(L.dy1, p1.y, MPFR_RNDN) | mpfr_sub_d(L.dy1, L.dy1, p0.y, MPFR_RNDN);
+  inexact |= mpfr_set_d(L.dx2, q1.x, MPFR_RNDN) | mpfr_sub_d(L.dx2, L.dx2, q0.x, MPFR_RNDN);
+  inexact |= mpfr_set_d(L.dy2, q1.y, MPFR_RNDN) | mpfr_sub_d(L.dy2, L.dy2, q0.y, MPFR_RNDN);
+  inexact |= mpfr_mul(L.t1, L.dx1, L.dy2, MPFR_RNDN);
+  inexact |= mpfr_mul(L.t2, L.dy1, L.dx2, MPFR_RNDN);
+  inexact |= mpfr_sub(out, L.t1, L.t2, MPFR_RNDN);
   return inexact == 0;
 }
 
-constexpr mpfr_prec_t kMpPrecisions[] = {128, 512, 2200, 8800};  // 2200 bits cover any difference of doubles
-
 int mp_cross_sign(const Point2& p0, const Point2& p1, const Point2& q0, const Point2& q1) {
-  for (mpfr_prec_t prec : kMpPrecisions) {
-    Mp out(2 * prec + 2);
-    if (mp_cross(p0, p1, q0, q1, prec, out)) return mpfr_sgn(out.get());
+  for (int i = 0; i < kMpLevels; ++i) {
+    MpLevel& L = mp_level(i);
+    if (mp_cross(p0, p1, q0, q1, L, L.o[0])) return mpfr_sgn(L.o[0]);
   }
   return 0;  // unreachable for finite input
 }
@@ -193,17 +210,16 @@ namespace {
 /// Exact sign of Oga*Ofb - Ofa*Ogb with O_s(P) = (s1 - s0) x (P - s0).
 int mp_crossing_num_sign(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1, const Point2& g0,
                          const Point2& g1) {
-  for (mpfr_prec_t prec : kMpPrecisions) {
-    const mpfr_prec_t p2 = 2 * prec + 2;
-    Mp ofa(p2), ofb(p2), oga(p2), ogb(p2);
-    if (!mp_cross(f0, f1, f0, a, prec, ofa) || !mp_cross(f0, f1, f0, b, prec, ofb) ||
-        !mp_cross(g0, g1, g0, a, prec, oga) || !mp_cross(g0, g1, g0, b, prec, ogb))
+  for (int i = 0; i < kMpLevels; ++i) {
+    MpLevel& L = mp_level(i);
+    mpfr_ptr ofa = L.o[0], ofb = L.o[1], oga = L.o[2], ogb = L.o[3];
+    if (!mp_cross(f0, f1, f0, a, L, ofa) || !mp_cross(f0, f1, f0, b, L, ofb) || !mp_cross(g0, g1, g0, a, L, oga) ||
+        !mp_cross(g0, g1, g0, b, L, ogb))
       continue;
-    Mp p1(2 * p2), p2m(2 * p2), num(2 * p2 + 2);
-    int inexact = mpfr_mul(p1.get(), oga.get(), ofb.get(), MPFR_RNDN);
-    inexact |= mpfr_mul(p2m.get(), ofa.get(), ogb.get(), MPFR_RNDN);
-    inexact |= mpfr_sub(num.get(), p1.get(), p2m.get(), MPFR_RNDN);
-    if (inexact == 0) return mpfr_sgn(num.get());
+    int inexact = mpfr_mul(L.p1, oga, ofb, MPFR_RNDN);
+    inexact |= mpfr_mul(L.p2, ofa, ogb, MPFR_RNDN);
+    inexact |= mpfr_sub(L.num, L.p1, L.p2, MPFR_RNDN);
+    if (inexact == 0) return mpfr_sgn(L.num);
   }
   return 0;
 }
