@@ -226,6 +226,15 @@ int mp_crossing_num_sign(const Point2& a, const Point2& b, const Point2& f0, con
 
 }  // namespace
 
+namespace {
+/// Whether g0 and g1 lie on the line through f0 and f1 (f0 != f1), exactly.
+bool on_one_line(const Point2& f0, const Point2& f1, const Point2& g0, const Point2& g1) {
+  auto same = [](const Point2& u, const Point2& v) { return u.x == v.x && u.y == v.y; };
+  if ((same(f0, g0) && same(f1, g1)) || (same(f0, g1) && same(f1, g0))) return true;
+  return orient(f0, f1, g0) == 0 && orient(f0, f1, g1) == 0;
+}
+}  // namespace
+
 int compare_crossings(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1, const Point2& g0,
                       const Point2& g1) {
   // t_f - t_g = (Oga*Ofb - Ofa*Ogb) / ((Ofa - Ofb)(Oga - Ogb)), and Ofa - Ofb = (b - a) x (f1 - f0):
@@ -245,6 +254,13 @@ int compare_crossings(const Point2& a, const Point2& b, const Point2& f0, const 
       count(Family::CompareCrossings, 0);
       return sgn(num) * sden;
     }
+  }
+  // Exact ties, which no filter can certify, are mostly f and g on one line: the same edge of two
+  // facets (a triangulated surface, one copy each way), or pieces of one wall. Then both cross a->b
+  // at one point, t_f = t_g exactly (g0 != g1, as sden != 0); the exact test is two orientations.
+  if (on_one_line(f0, f1, g0, g1)) {
+    count(Family::CompareCrossings, 1);
+    return 0;
   }
   {
     const ApproxDD fa = cross_dd(f0, f1, f0, a), fb = cross_dd(f0, f1, f0, b);

@@ -103,6 +103,29 @@ TEST(RobustPredicates, ExactTieOfCrossingsEscalatesToTheLastRung) {
   EXPECT_EQ(s.at(Family::CompareCrossings, 2), 1u);
 }
 
+TEST(RobustPredicates, TieOfCrossingsOnOneLineIsCertifiedWithoutMpfr) {
+  // The shadow of a triangulated model (kml-collada-macky-google): one edge of two facets, once each
+  // way, and a piece of the same line. Both cross a->b at one point; no filter can certify the zero,
+  // two exact orientations can.
+  const Point2 a{476737.1016862634, 4428897.4633007497}, b{476736.66929938842, 4428933.5569486981};
+  const Point2 f0{476743.939623432, 4428897.5452279719}, f1{476737.10164363409, 4428897.4633117458};
+  reset_rung_stats();
+  EXPECT_EQ(compare_crossings(a, b, f0, f1, f0, f1), 0);
+  EXPECT_EQ(compare_crossings(a, b, f0, f1, f1, f0), 0);
+  const Point2 mid{(f0.x + f1.x) / 2, (f0.y + f1.y) / 2};
+  if (orient(f0, f1, mid) == 0) EXPECT_EQ(compare_crossings(a, b, f0, f1, mid, f1), 0);
+  const RungStats s = rung_stats();
+  EXPECT_EQ(s.at(Family::CompareCrossings, 2), 0u);
+  EXPECT_GE(s.at(Family::CompareCrossings, 1), 2u);
+  // Not on one line, crossing a->b at one point: still the last rung (the shortcut must not fire).
+  reset_rung_stats();
+  const Point2 c{5000000.0, 3000000.0}, d{5000010.0, 3000010.0};
+  EXPECT_EQ(compare_crossings(c, d, {5000004.0, 3000000.0}, {5000006.0, 3000010.0}, {5000000.0, 3000010.0},
+                              {5000010.0, 3000000.0}),
+            0);
+  EXPECT_EQ(rung_stats().at(Family::CompareCrossings, 2), 1u);
+}
+
 TEST(RobustPredicates, NearestCrossingsByVisibilityBisection) {
   const Point2 a{0, 0}, b{100, 0};
   std::vector<Segment> segs;
