@@ -7,8 +7,13 @@
 #include <groundplan/gis/pipeline.h>
 #include <groundplan/gis/reader.h>
 
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <deque>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -140,6 +145,30 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
 
   const auto t_read = clock_type::now();
   double footprint_s = 0;
+  // Footprints are made on the other cores while this thread reads on (DESIGN.md: one machine, all
+  // cores), each into its slot in reading order, so the output and the problems come out exactly as
+  // if made one by one. When too many wait, the reader makes the next one itself: memory stays
+  // bounded (a slot holds its mesh until its footprint is made).
+  struct Slot {
+    Mesh mesh;
+    std::string source_id, file;
+    std::size_t problem_pos = 0;  // where its problem goes among the others (result.problems.size() then)
+    FootprintResult fp;
+  };
+  std::deque<Slot> slots;  // stable addresses: a task holds a pointer to its slot
+  tbb::task_group footprint_tasks;
+  std::atomic<std::size_t> pending{0};
+  const std::size_t max_pending = 16 * static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  struct WaitOnExit {  // the tasks use this frame's locals: never leave it with one still running
+    tbb::task_group& g;
+    ~WaitOnExit() {
+      g.cancel();
+      try {
+        g.wait();
+      } catch (...) {
+      }
+    }
+  } wait_on_exit{footprint_tasks};
   for (std::size_t fi = 0; fi < files.size(); ++fi) {
     const std::string& file = files[fi];
     const Progress file_progress = progress.sub(0.6 * static_cast<double>(fi) / static_cast<double>(files.size()),
@@ -180,17 +209,24 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
         ++result.buildings_dropped;
         return;
       }
-      const auto t_fp = clock_type::now();
-      FootprintResult fp = make_footprint(mesh, footprint_params);
-      footprint_s += seconds_since(t_fp);
-      if (!fp.ok) {
-        result.problems.push_back({mesh.source_id, file, "footprint", fp.code, fp.reason});
-        ++result.buildings_dropped;
-        return;
+      Slot& slot = slots.emplace_back();
+      slot.source_id = mesh.source_id;
+      slot.mesh = std::move(mesh);
+      slot.file = file;
+      slot.problem_pos = result.problems.size();
+      if (pending.load(std::memory_order_relaxed) >= max_pending) {
+        const auto t_fp = clock_type::now();
+        slot.fp = make_footprint(slot.mesh, footprint_params);
+        slot.mesh = Mesh{};
+        footprint_s += seconds_since(t_fp);
+      } else {
+        pending.fetch_add(1, std::memory_order_relaxed);
+        footprint_tasks.run([&footprint_params, &pending, s = &slot] {
+          s->fp = make_footprint(s->mesh, footprint_params);
+          s->mesh = Mesh{};
+          pending.fetch_sub(1, std::memory_order_relaxed);
+        });
       }
-      fp.footprint.source_file = file;
-      fp.footprint.method = to_string(fp.method);
-      result.footprints.push_back(std::move(fp.footprint));
       if ((result.buildings_read & 1023) == 0) file_progress.report(0.5, "reading");
     };
     try {
@@ -242,9 +278,37 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
       }
     }
   }
+  // read: the reading thread's time less the footprints it made itself; footprints: those, and the
+  // wait for the rest after reading (the time they added to the run, not their CPU time).
+  const double read_s = seconds_since(t_read) - footprint_s;
+  const auto t_wait = clock_type::now();
+  footprint_tasks.wait();
+  footprint_s += seconds_since(t_wait);
+  // In reading order: each footprint, or its problem where it would have stood had it been made
+  // on the spot.
+  {
+    std::vector<Problem> problems;
+    problems.reserve(result.problems.size() + slots.size());
+    std::size_t next = 0;  // next problem of result.problems to copy
+    for (Slot& slot : slots) {
+      FootprintResult& fp = slot.fp;
+      if (fp.ok) {
+        fp.footprint.source_file = slot.file;
+        fp.footprint.method = to_string(fp.method);
+        result.footprints.push_back(std::move(fp.footprint));
+        continue;
+      }
+      for (; next < slot.problem_pos; ++next) problems.push_back(std::move(result.problems[next]));
+      problems.push_back({slot.source_id, slot.file, "footprint", fp.code, fp.reason});
+      ++result.buildings_dropped;
+    }
+    for (; next < result.problems.size(); ++next) problems.push_back(std::move(result.problems[next]));
+    result.problems = std::move(problems);
+    slots.clear();
+  }
   if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
   result.timings.footprints_s = footprint_s;
-  result.timings.read_s = seconds_since(t_read) - footprint_s;
+  result.timings.read_s = read_s;
 
   const auto t_union = clock_type::now();
   UnionStats union_stats;

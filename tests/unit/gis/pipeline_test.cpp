@@ -8,8 +8,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "test_support.h"
 
@@ -141,6 +144,85 @@ TEST(Pipeline, AxisOrderOptionPlacesALonLatFileWhereItIs) {
   EXPECT_NEAR(p.y, 4306600, 1000);
   EXPECT_GT(swapped.plans[0].area_m2, 100);  // a building, not a degenerate sliver
   EXPECT_THROW(gis::axis_order_from_string("sideways"), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace groundplan
+
+namespace groundplan {
+namespace {
+
+// Footprints are made on other cores while the file is read on; the result must not show it: the
+// footprints in reading order, and each footprint problem where it stands in reading order among
+// the reader's own problems, exactly as when they were made one by one.
+TEST(Pipeline, FootprintsMadeInParallelComeOutInReadingOrder) {
+  namespace fs = std::filesystem;
+  auto ring = [](double x0, double y0, double x1, double y1, double z0, double z1, int side) {
+    // side 0: floor, 1: roof, 2..5: walls of the box [x0,x1]x[y0,y1]x[z0,z1]
+    char buf[512];
+    switch (side) {
+      case 0: std::snprintf(buf, sizeof buf, "%.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f", x0, y0, z0, x0, y1, z0, x1, y1, z0, x1, y0, z0, x0, y0, z0); break;
+      case 1: std::snprintf(buf, sizeof buf, "%.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f", x0, y0, z1, x1, y0, z1, x1, y1, z1, x0, y1, z1, x0, y0, z1); break;
+      case 2: std::snprintf(buf, sizeof buf, "%.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f", x0, y0, z0, x1, y0, z0, x1, y0, z1, x0, y0, z1, x0, y0, z0); break;
+      case 3: std::snprintf(buf, sizeof buf, "%.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f", x1, y0, z0, x1, y1, z0, x1, y1, z1, x1, y0, z1, x1, y0, z0); break;
+      case 4: std::snprintf(buf, sizeof buf, "%.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f", x1, y1, z0, x0, y1, z0, x0, y1, z1, x1, y1, z1, x1, y1, z0); break;
+      default: std::snprintf(buf, sizeof buf, "%.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f %.1f", x0, y1, z0, x0, y0, z0, x0, y0, z1, x0, y1, z1, x0, y1, z0); break;
+    }
+    return "<gml:surfaceMember><gml:Polygon><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">" +
+           std::string(buf) + "</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember>\n";
+  };
+  // Building i: i % 3 == 0 a box; 1 two parallel walls only (no footprint: a problem of stage
+  // "footprint"); 2 a box with a two-point ring too (a problem of stage "read", footprint made).
+  const int n = 600;
+  std::string gml =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<core:CityModel xmlns:core=\"http://www.opengis.net/citygml/2.0\" "
+      "xmlns:bldg=\"http://www.opengis.net/citygml/building/2.0\" xmlns:gml=\"http://www.opengis.net/gml\">\n"
+      "<gml:boundedBy><gml:Envelope srsName=\"EPSG:25832\" srsDimension=\"3\"><gml:lowerCorner>400000 5860000 40"
+      "</gml:lowerCorner><gml:upperCorner>412000 5860100 48</gml:upperCorner></gml:Envelope></gml:boundedBy>\n";
+  for (int i = 0; i < n; ++i) {
+    const double x0 = 400000.0 + 20.0 * i, y0 = 5860000.0, x1 = x0 + 10, y1 = y0 + 8;
+    gml += "<core:cityObjectMember><bldg:Building gml:id=\"B" + std::to_string(i) +
+           "\"><bldg:lod1Solid><gml:Solid><gml:exterior><gml:CompositeSurface>\n";
+    if (i % 3 == 1) {
+      gml += ring(x0, y0, x1, y1, 40, 48, 2) + ring(x0, y0, x1, y1, 40, 48, 4);
+    } else {
+      for (int side = 0; side < 6; ++side) gml += ring(x0, y0, x1, y1, 40, 48, side);
+      if (i % 3 == 2)
+        gml += "<gml:surfaceMember><gml:Polygon><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">" +
+               std::to_string(x0) + " 5860000 48 " + std::to_string(x1) + " 5860000 48 " + std::to_string(x0) +
+               " 5860000 48</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember>\n";
+    }
+    gml += "</gml:CompositeSurface></gml:exterior></gml:Solid></bldg:lod1Solid></bldg:Building></core:cityObjectMember>\n";
+  }
+  gml += "</core:CityModel>\n";
+  const fs::path file = fs::temp_directory_path() / "groundplan_parallel_footprints_test.gml";
+  {
+    std::FILE* f = std::fopen(file.string().c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(gml.data(), 1, gml.size(), f);
+    std::fclose(f);
+  }
+  gis::PipelineOptions options;
+  options.inputs = {file.string()};
+  const gis::PipelineResult r = gis::run_pipeline(options);
+  fs::remove(file);
+
+  std::vector<std::string> want_fp;
+  for (int i = 0; i < n; ++i)
+    if (i % 3 != 1) want_fp.push_back("B" + std::to_string(i));
+  std::vector<std::string> got_fp;
+  for (const Footprint& f : r.footprints) got_fp.push_back(f.source_id);
+  EXPECT_EQ(got_fp, want_fp);
+
+  // Problems naming buildings, in order: B1 (footprint), B2 (read), B4 (footprint), B5 (read), ...
+  std::vector<std::string> want_pb, got_pb;
+  for (int i = 0; i < n; ++i)
+    if (i % 3 != 0) want_pb.push_back("B" + std::to_string(i) + (i % 3 == 1 ? " footprint" : " read"));
+  for (const Problem& p : r.problems)
+    if (!p.source_id.empty()) got_pb.push_back(p.source_id + " " + p.stage);
+  EXPECT_EQ(got_pb, want_pb);
+  EXPECT_EQ(r.buildings_read, static_cast<std::size_t>(n));
+  EXPECT_EQ(r.buildings_dropped, static_cast<std::size_t>(n / 3));
 }
 
 }  // namespace

@@ -28,6 +28,8 @@ struct PipelineOptions {
 };
 
 struct StageTimings {
+  // footprints_s: the time footprints added to the run (they are made on the other cores while the
+  // file is read; this is what the reader made itself plus the wait after reading), not CPU time.
   double read_s = 0, footprints_s = 0, blocks_s = 0, union_s = 0;  // union_s: boundary evaluation only
   double lod_s = 0;  // level-of-detail steps (snap, close gaps, simplify, filters)
 };
