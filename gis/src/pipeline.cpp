@@ -150,14 +150,18 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
   // if made one by one. When too many wait, the reader makes the next one itself: memory stays
   // bounded (a slot holds its mesh until its footprint is made).
   struct Slot {
-    Mesh mesh;
-    std::string source_id, file;
+    Mesh mesh;                    // until its footprint is made
+    std::size_t file = 0;         // index into files
     std::size_t problem_pos = 0;  // where its problem goes among the others (result.problems.size() then)
-    FootprintResult fp;
+    FootprintResult fp;           // fp.footprint.source_id names the building, made or not
   };
   std::deque<Slot> slots;  // stable addresses: a task holds a pointer to its slot
   tbb::task_group footprint_tasks;
   std::atomic<std::size_t> pending{0};
+  auto make = [&footprint_params](Slot& s) {
+    s.fp = make_footprint(s.mesh, footprint_params);
+    s.mesh = Mesh{};
+  };
   const std::size_t max_pending = 16 * static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   struct WaitOnExit {  // the tasks use this frame's locals: never leave it with one still running
     tbb::task_group& g;
@@ -210,20 +214,17 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
         return;
       }
       Slot& slot = slots.emplace_back();
-      slot.source_id = mesh.source_id;
       slot.mesh = std::move(mesh);
-      slot.file = file;
+      slot.file = fi;
       slot.problem_pos = result.problems.size();
       if (pending.load(std::memory_order_relaxed) >= max_pending) {
         const auto t_fp = clock_type::now();
-        slot.fp = make_footprint(slot.mesh, footprint_params);
-        slot.mesh = Mesh{};
+        make(slot);
         footprint_s += seconds_since(t_fp);
       } else {
         pending.fetch_add(1, std::memory_order_relaxed);
-        footprint_tasks.run([&footprint_params, &pending, s = &slot] {
-          s->fp = make_footprint(s->mesh, footprint_params);
-          s->mesh = Mesh{};
+        footprint_tasks.run([&make, &pending, s = &slot] {
+          make(*s);
           pending.fetch_sub(1, std::memory_order_relaxed);
         });
       }
@@ -293,13 +294,13 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     for (Slot& slot : slots) {
       FootprintResult& fp = slot.fp;
       if (fp.ok) {
-        fp.footprint.source_file = slot.file;
+        fp.footprint.source_file = files[slot.file];
         fp.footprint.method = to_string(fp.method);
         result.footprints.push_back(std::move(fp.footprint));
         continue;
       }
       for (; next < slot.problem_pos; ++next) problems.push_back(std::move(result.problems[next]));
-      problems.push_back({slot.source_id, slot.file, "footprint", fp.code, fp.reason});
+      problems.push_back({fp.footprint.source_id, files[slot.file], "footprint", fp.code, fp.reason});
       ++result.buildings_dropped;
     }
     for (; next < result.problems.size(); ++next) problems.push_back(std::move(result.problems[next]));

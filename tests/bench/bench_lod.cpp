@@ -296,19 +296,11 @@ int run_matrix(const std::string& sizes, std::size_t geos_max, int runs_arg, int
         ok = false;
       }
     };
-    go("union", 0, runs);
-    go("close", 0.1, runs);
-    go("close", 0.5, runs);
-    go("snap", 0, runs);
-    go("simplify", 0, runs);
-    go("cfd", 0, runs);
-    if (n <= geos_max) {
-      go("geos_union", 0, gruns);
-      go("geos_close", 0.1, gruns);
-      go("geos_close", 0.5, gruns);
-      go("geos_snap", 0, gruns);
-      go("geos_simplify", 0, gruns);
-      go("geos_cfd", 0, gruns);
+    const std::pair<const char*, double> ops[] = {{"union", 0},  {"close", 0.1},   {"close", 0.5},
+                                                  {"snap", 0},   {"simplify", 0}, {"cfd", 0}};
+    for (const std::string prefix : {"", "geos_"}) {
+      if (!prefix.empty() && n > geos_max) continue;
+      for (const auto& [op, d] : ops) go(prefix + op, d, prefix.empty() ? runs : gruns);
     }
     all.emplace_back(n, std::move(lines));
   }

@@ -20,7 +20,6 @@
 #include <groundplan/gis/reader.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <cstdio>
 #include <cstdlib>
@@ -29,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "decompose_dump.h"
 #include "test_config.h"
 #include "test_support.h"
@@ -36,25 +36,11 @@
 namespace {
 
 using namespace groundplan;
-using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
 using test::without_ground;
 
-/// Median seconds of one pass of f over ~0.5 s of passes (at least 5).
-template <class F>
-double median_seconds(F&& f) {
-  std::vector<double> t;
-  double spent = 0;
-  while (spent < 0.5 || t.size() < 5) {
-    const auto t0 = Clock::now();
-    f();
-    t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
-    spent += t.back();
-  }
-  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
-  return t[t.size() / 2];
-}
+using bench::median_seconds;
 
 struct Set {
   std::string name;

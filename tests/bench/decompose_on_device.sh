@@ -11,7 +11,7 @@ exec > >(tee "$OUT/decompose.log") 2>&1
 echo "== machine"; date -u; nproc; lscpu | grep -E "^(Model name|CPU max MHz|CPU MHz|Thread|Core|Socket|L2|L3)" ; uptime
 g++ --version | head -1
 B=build-replay; mkdir -p $B
-FLAGS="-std=c++20 -O3 -DNDEBUG -ffp-contract=off -Icore/include -Icore/src -Itests/bench"
+FLAGS="-std=c++20 -O3 -DNDEBUG -ffp-contract=off -Icore/include -Icore/src -Itests/bench -Itests/support"
 if [ -f /usr/include/mpfr.h ] && [ -d /usr/include/tbb ]; then
   echo "== build with the union engine (MPFR and TBB found)"
   srcs=$(find core/src -name '*.cpp'); libs="-lmpfr -lgmp -ltbb"

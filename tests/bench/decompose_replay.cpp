@@ -24,25 +24,20 @@
 #include <thread>
 #include <vector>
 
+#include "bench_util.h"
 #include "decompose_dump.h"
 
 namespace {
 using namespace groundplan;
 using Clock = std::chrono::steady_clock;
 
+/// Median seconds of one pass over the meshes.
 double median_seconds(const std::vector<Mesh>& ms) {
-  std::vector<double> t;
-  double spent = 0;
   std::size_t sink = 0;
-  while (spent < 0.5 || t.size() < 5) {
-    const auto t0 = Clock::now();
+  const double sec = bench::median_seconds([&] {
     for (const Mesh& m : ms) sink += footprint::decompose_footprint(m).polygons.size();
-    t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
-    spent += t.back();
-  }
-  if (sink == 0xFFFFFFFF) std::puts("");  // keeps the work observable
-  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
-  return t[t.size() / 2];
+  });
+  return sec + (sink == 0xFFFFFFFF);  // keeps the work observable
 }
 /// Seconds per decomposition of m: median of 5 samples, each >= 20 us of repeated calls.
 double seconds_per_call(const Mesh& m) {

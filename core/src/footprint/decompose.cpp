@@ -65,9 +65,6 @@ struct V3 {
 };
 inline V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 inline double dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 cross(const V3& a, const V3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
 
 enum : std::uint8_t { kFloor = 0, kCeiling = 1, kWall = 2, kSkipped = 255 };
 
@@ -168,11 +165,6 @@ inline std::uint64_t mix64(std::uint64_t h) {
   return h;
 }
 
-[[maybe_unused]] inline std::size_t pow2_at_least(std::size_t n) {
-  std::size_t s = 16;
-  while (s < n) s <<= 1;
-  return s;
-}
 
 struct Workspace {
   std::vector<std::uint32_t> weld;      // mesh vertex -> welded id
@@ -224,6 +216,28 @@ struct Workspace {
   std::vector<std::uint32_t> floor_uf;
   std::vector<std::uint8_t> hanging;
 };
+
+/// Half-edge h, of the undirected edge lo < hi, into its group (groups numbered in order of first
+/// appearance; cnt counts each group's half-edges). The earlier half-edges with the same smaller
+/// vertex are chained per vertex (head, next; hmax their larger vertex), a handful, so h finds its
+/// group by walking that chain.
+inline void group_half_edge(std::uint32_t h, std::uint32_t lo, std::uint32_t hi, std::uint32_t* head, std::uint32_t* next,
+                            std::uint32_t* hmax, std::uint32_t* grp, std::uint32_t* cnt, std::uint32_t& ng) {
+  std::uint32_t j = head[lo];
+  while (j != kNone && hmax[j] != hi) j = next[j];
+  std::uint32_t g;
+  if (j == kNone) {
+    g = ng++;
+    cnt[g] = 0;
+  } else {
+    g = grp[j];
+  }
+  ++cnt[g];
+  grp[h] = g;
+  hmax[h] = hi;
+  next[h] = head[lo];
+  head[lo] = h;
+}
 
 Workspace& workspace() {
   thread_local Workspace ws;
@@ -732,21 +746,7 @@ class Decomposer {
         std::uint32_t a = out[i], b = out[i + 1 < k ? i + 1 : 0];
         if (reverse) std::swap(a, b);
         HE[h] = HalfEdge{a, b, f, wall ? rise(W, n, len2, a, b) : std::int8_t{0}};
-        const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
-        std::uint32_t j = head[lo];
-        while (j != kNone && hmax[j] != hi) j = next[j];
-        std::uint32_t g;
-        if (j == kNone) {
-          g = g_n++;
-          cnt[g] = 1;
-        } else {
-          g = grp[j];
-          ++cnt[g];
-        }
-        grp[h] = g;
-        hmax[h] = hi;
-        next[h] = head[lo];
-        head[lo] = h;
+        group_half_edge(h, std::min(a, b), std::max(a, b), head, next, hmax, grp, cnt, g_n);
         ++h;
       }
       nh = h;
@@ -843,23 +843,8 @@ class Decomposer {
     std::uint32_t* cnt = count.data();
     std::uint32_t ng = 0;
     const HalfEdge* H = ws_.halfedges.data();
-    for (std::uint32_t i = 0; i < nh; ++i) {
-      const std::uint32_t lo = std::min(H[i].a, H[i].b), hi = std::max(H[i].a, H[i].b);
-      std::uint32_t j = H0[lo];
-      while (j != kNone && hmax[j] != hi) j = next[j];
-      std::uint32_t g;
-      if (j == kNone) {
-        g = ng++;
-        cnt[g] = 0;
-      } else {
-        g = grp[j];
-      }
-      grp[i] = g;
-      ++cnt[g];
-      hmax[i] = hi;
-      next[i] = H0[lo];
-      H0[lo] = i;
-    }
+    for (std::uint32_t i = 0; i < nh; ++i)
+      group_half_edge(i, std::min(H[i].a, H[i].b), std::max(H[i].a, H[i].b), H0, next, hmax, grp, cnt, ng);
     count.resize(ng);
     sort_group_members(ng);
   }
