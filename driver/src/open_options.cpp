@@ -50,6 +50,8 @@ const char* open_option_list_xml() {
          "listed in the problems layer (0 = off)' default='0'/>"
          "  <Option name='SIMPLIFY' type='float' description='Metres: topology-preserving simplification tolerance "
          "(0 = off)' default='0'/>"
+         "  <Option name='NUM_THREADS' type='string' description='Threads for every stage: a number or ALL_CPUS "
+         "(default: the GDAL_NUM_THREADS config option, else all cores)' default='ALL_CPUS'/>"
          "</OpenOptionList>";
 }
 
@@ -110,6 +112,10 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
   lod_value("SIMPLIFY", &o.detail.simplify_m);
   if (const char* v = CSLFetchNameValue(open_options, "ORIGIN")) o.origin = v;
   if (const char* v = CSLFetchNameValue(open_options, "AXIS_ORDER")) o.source_axis = gis::axis_order_from_string(v);
+  if (const char* v = CSLFetchNameValue(open_options, "NUM_THREADS"))
+    o.threads = gis::threads_from_string(v, "open option NUM_THREADS");
+  else if (const char* g = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))
+    o.threads = gis::threads_from_string(g, "GDAL_NUM_THREADS");
   return o;
 }
 

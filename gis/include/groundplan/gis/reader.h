@@ -16,6 +16,8 @@
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +33,7 @@ struct ReadOptions {
   std::string origin;           // "lon,lat[,alt]" for glTF without georeference and bare .dae; empty = none
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
+  std::function<void(std::uint64_t)> on_bytes;  // CityGML: told the bytes as they are read (progress); may be empty
 };
 
 struct ReadInfo {
