@@ -387,7 +387,8 @@ int run(int argc, char** argv) {
     progress = groundplan::Progress([](double f, const char* msg) {
       return GDALTermProgress(f, msg, nullptr) != FALSE;
     });
-  const PipelineResult result = groundplan::gis::run_pipeline(options, progress.sub(0, 1));
+  const auto result_ptr = std::make_shared<const PipelineResult>(groundplan::gis::run_pipeline(options, progress.sub(0, 1)));
+  const PipelineResult& result = *result_ptr;
 
   // Nothing usable (every building a problem, or no building at all): say so and fail, without
   // writing an empty result that would look like success (issue 8). The problems say why.
@@ -405,7 +406,7 @@ int run(int argc, char** argv) {
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
   const bool dbf = writes_dbf(ogr);
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
-                                                             result, dbf ? 254 : 0);
+                                                             result_ptr, dbf ? 254 : 0, options.threads);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
   std::vector<std::string> vt_args = ogr.options;
   if (!ogr.layer_named) vt_args.push_back("ground_plans");
