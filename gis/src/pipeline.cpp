@@ -9,6 +9,7 @@
 
 #include "pipeline/file_reading.h"
 
+#include <cpl_string.h>
 #include <cpl_vsi.h>
 #include <sys/resource.h>
 #include <tbb/info.h>
@@ -40,9 +41,9 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF;
+/// Files named by the inputs: a file as is, a folder or a .zip as its input files (CityGML, KML/KMZ, glTF;
 /// not .dae, which belong to a .kml beside them) sorted by name.
-std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
     std::error_code ec;
@@ -53,6 +54,28 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
       std::sort(found.begin(), found.end());
       if (found.empty())
         throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb)");
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (lower(fs::path(in).extension().string()) == ".zip") {
+      // A zip of tiles: its input entries, sorted (read through GDAL's /vsizip/, side by side like a folder).
+      const std::string root = in.rfind("/vsizip/", 0) == 0 ? in : "/vsizip/" + in;
+      std::vector<std::string> found;
+      char** list = VSIReadDirRecursive(root.c_str());
+      for (char** e = list; e && *e; ++e) {
+        const std::string entry(*e);
+        const bool escapes = entry.empty() || entry[0] == '/' || entry[0] == '\\' || entry.find("..") != std::string::npos;
+        // GDAL 3.6's listing already leaves out "../x" and "/x"; checked again, and said, in case another does not.
+        if (escapes && is_input_name(entry))
+          problems.push_back({"", in, "read", "UNSAFE_PATH",
+                              "zip entry \"" + entry.substr(0, 200) + "\" names a path outside the archive; not read"});
+        else if (is_input_name(entry))
+          found.push_back(root + "/" + entry);
+      }
+      CSLDestroy(list);
+      if (!fs::exists(in, ec) && in.rfind("/vsi", 0) != 0) throw InputError(in + ": no such file or folder");
+      std::sort(found.begin(), found.end());
+      if (found.empty())
+        throw InputError(in + ": the zip holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb), or "
+                              "is not a zip");
       files.insert(files.end(), found.begin(), found.end());
     } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0) {
       files.push_back(in);
@@ -186,7 +209,7 @@ void merge_file(detail::FileRead&& r, const std::string& file, detail::ReadConte
 PipelineResult run(const PipelineOptions& options, const Progress& progress, std::size_t threads) {
   const double cpu0 = cpu_seconds();
   PipelineResult result;
-  const std::vector<std::string> files = expand_inputs(options.inputs);
+  const std::vector<std::string> files = expand_inputs(options.inputs, result.problems);
   result.reading.files = files.size();
   result.reading.threads = threads;
   result.reading.bytes = total_bytes(files);

@@ -70,3 +70,19 @@ def test_driver_num_threads_gives_the_same_layers():
         lyr = ds.GetLayerByName("ground_plans")
         rows.append([(f.items(), f.GetGeometryRef().ExportToIsoWkt()) for f in lyr])
     assert len(rows[0]) > 100 and rows[0] == rows[1]
+
+
+def test_a_zip_of_tiles_is_read_like_the_folder(tmp_path):
+    import zipfile
+    folder = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
+    archive = tmp_path / "tiles.zip"
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as z:
+        for tile in sorted(folder.glob("*.gml")):
+            z.write(tile, f"tiles/{tile.name}")
+        z.writestr("../escape.gml", (folder / "LoD1_24065860_2_2021-01-25.gml").read_bytes())
+        z.writestr("README.txt", "not an input")
+    from_folder, _ = csv_hashes(tmp_path, "folder", folder)
+    from_zip, stats = csv_hashes(tmp_path, "zip", archive)
+    # Not README.txt; not "../escape.gml" either (GDAL's /vsizip/ listing leaves out entries outside the archive)
+    assert stats["reading"]["files"] == 4
+    assert from_zip["ground_plans"] == from_folder["ground_plans"]
