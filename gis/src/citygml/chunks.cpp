@@ -7,11 +7,13 @@
 #include "citygml/file_problems.h"
 
 #include <cpl_vsi.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cstring>
 #include <string_view>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace groundplan::gis {
 namespace {
@@ -153,7 +155,6 @@ std::string merge_citygml_chunks(const std::string& path, const CityGmlChunkPlan
   merged = SourceInfo{};
   merged.file = path;
   int file_dimension = 0;  // the whole-file reader's default srsDimension where the chunk starts
-  std::unordered_map<std::string_view, std::size_t> chunk_of_id;
   for (std::size_t k = 0; k < infos.size(); ++k) {
     const SourceInfo& in = infos[k];
     const CityGmlChunkWatch& w = watches[k];
@@ -164,10 +165,6 @@ std::string merge_citygml_chunks(const std::string& path, const CityGmlChunkPlan
     if (file_dimension != 0 && (w.dimension_defaults & ~(1u << file_dimension)) != 0)
       return "coordinates without srsDimension before the file's first srsDimension";
     if (file_dimension == 0) file_dimension = in.srs_dimension;
-    for (const std::string& id : w.building_ids) {
-      const auto [it, added] = chunk_of_id.emplace(id, k);
-      if (!added && it->second != k) return "gml:id \"" + id + "\" is used in two chunks (DUPLICATE_ID)";
-    }
     if (merged.citygml_version.empty()) merged.citygml_version = in.citygml_version;
     if (merged.srs_name.empty()) {
       merged.srs_name = in.srs_name;
@@ -196,6 +193,15 @@ std::string merge_citygml_chunks(const std::string& path, const CityGmlChunkPlan
     merged.xlinks_resolved += in.xlinks_resolved;
     merged.xlinks_missing += in.xlinks_missing;
   }
+  // A gml:id in two chunks: each chunk's reader saw only its own (DUPLICATE_ID is said per file).
+  // Sorted on all cores: one hash set of every id would be a serial pass over the whole file's ids.
+  std::vector<std::pair<std::string_view, std::size_t>> ids;
+  for (std::size_t k = 0; k < watches.size(); ++k)
+    for (const std::string& id : watches[k].building_ids) ids.emplace_back(id, k);
+  tbb::parallel_sort(ids.begin(), ids.end());
+  for (std::size_t i = 1; i < ids.size(); ++i)
+    if (ids[i].first == ids[i - 1].first && ids[i].second != ids[i - 1].second)
+      return "gml:id \"" + std::string(ids[i].first) + "\" is used in two chunks (DUPLICATE_ID)";
   merged.bytes = plan.file_bytes;
   detail::add_file_problems(merged, path, file_problems);
   return {};

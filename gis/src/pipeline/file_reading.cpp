@@ -183,7 +183,10 @@ class FootprintMaker {
 };
 
 /// Appends a part (its footprints made) to the file's outcome, problems in reading order.
-void append(Part& part, const std::string& file, FileRead& out, std::unordered_set<std::string>& delivered) {
+/// The ids of the meshes read, one set a part (not merged: that would be a serial pass over every id).
+using Delivered = std::vector<std::unordered_set<std::string>>;
+
+void append(Part& part, const std::string& file, FileRead& out, Delivered& delivered) {
   std::size_t next = 0;  // next problem of part.problems to copy
   for (Part::Slot& slot : part.slots) {
     FootprintResult& fp = slot.fp;
@@ -200,23 +203,27 @@ void append(Part& part, const std::string& file, FileRead& out, std::unordered_s
   for (; next < part.problems.size(); ++next) out.problems.push_back(std::move(part.problems[next]));
   out.buildings_read += part.buildings_read;
   out.buildings_dropped += part.buildings_dropped;
-  delivered.merge(part.delivered);
+  delivered.push_back(std::move(part.delivered));
   part = Part{};
 }
 
 /// The file's last words: buildings the reader gave up, notes, and the CRS facts for the pipeline.
-void finish_file(FileRead& out, const std::unordered_set<std::string>& delivered, const ReadInfo& info,
+void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info,
                  const WorkingFrame* frame, const std::string& file) {
   // Buildings the reader gave up count as read and dropped: nothing is lost silently. Whatever the
   // format, such a building is named by a read-stage Problem and gave no mesh (a building that did
   // give one may have read-stage defects too: a dropped face, a missing xlink).
+  auto was_delivered = [&](const std::string& id) {
+    return std::any_of(delivered.begin(), delivered.end(), [&](const auto& set) { return set.count(id) > 0; });
+  };
   std::unordered_set<std::string> given_up;
   for (const Problem& p : out.problems)
-    if (p.stage == "read" && !p.source_id.empty() && p.code != "NOTE" && !delivered.count(p.source_id))
+    if (p.stage == "read" && !p.source_id.empty() && p.code != "NOTE" && !given_up.count(p.source_id) &&
+        !was_delivered(p.source_id))
       given_up.insert(p.source_id);
   out.buildings_read += given_up.size();
   out.buildings_dropped += given_up.size();
-  out.delivered = !delivered.empty();
+  out.delivered = std::any_of(delivered.begin(), delivered.end(), [](const auto& set) { return !set.empty(); });
   if (info.in_working_crs) {
     for (const std::string& note : info.notes) out.problems.push_back({"", file, "georeference", "NOTE", note});
     out.in_working_crs = true;
@@ -275,7 +282,7 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
     VSIStatBufL st;
     if (VSIStatL(file.c_str(), &st) == 0) bytes.add(static_cast<std::uint64_t>(st.st_size));
   }
-  std::unordered_set<std::string> delivered;
+  Delivered delivered;
   append(part, file, out, delivered);
   finish_file(out, delivered, info, placer.frame.get(), file);
   return out;
@@ -350,7 +357,7 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
   if (!why.empty()) return std::nullopt;
 
   FileRead out;
-  std::unordered_set<std::string> delivered;
+  Delivered delivered;
   for (Part& part : parts) append(part, file, out, delivered);
   out.problems.insert(out.problems.end(), file_problems.begin(), file_problems.end());
   ReadInfo info;

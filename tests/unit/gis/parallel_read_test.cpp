@@ -225,3 +225,85 @@ TEST(ChunkedPipeline, FoldersOfTilesGiveTheOneThreadResult) {
 
 }  // namespace
 }  // namespace groundplan
+
+namespace groundplan {
+namespace {
+
+/// A CityGML 2.0 file of `members` (each a cityObjectMember's content), in EPSG:25832.
+std::string citygml_doc(const std::vector<std::string>& members) {
+  std::string doc =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<core:CityModel xmlns:core=\"http://www.opengis.net/citygml/2.0\" "
+      "xmlns:bldg=\"http://www.opengis.net/citygml/building/2.0\" xmlns:gml=\"http://www.opengis.net/gml\" "
+      "xmlns:xlink=\"http://www.w3.org/1999/xlink\">\n";
+  for (const std::string& m : members) doc += "<core:cityObjectMember>" + m + "</core:cityObjectMember>\n";
+  return doc + "</core:CityModel>\n";
+}
+
+/// A building with one GroundSurface square at (x, y); `poly_id` names its polygon ("" = none).
+std::string building(const std::string& id, double x, double y, const std::string& poly_id = "") {
+  auto c = [](double v) { return std::to_string(v); };
+  const std::string ring = c(x) + " " + c(y) + " 0 " + c(x + 10) + " " + c(y) + " 0 " + c(x + 10) + " " + c(y + 10) +
+                           " 0 " + c(x) + " " + c(y + 10) + " 0 " + c(x) + " " + c(y) + " 0";
+  return "<bldg:Building" + (id.empty() ? std::string() : " gml:id=\"" + id + "\"") +
+         "><bldg:boundedBy><bldg:GroundSurface><bldg:lod2MultiSurface><gml:MultiSurface srsName=\"EPSG:25832\" "
+         "srsDimension=\"3\"><gml:surfaceMember><gml:Polygon" +
+         (poly_id.empty() ? std::string() : " gml:id=\"" + poly_id + "\"") +
+         "><gml:exterior><gml:LinearRing><gml:posList>" + ring +
+         "</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember></gml:MultiSurface>"
+         "</bldg:lod2MultiSurface></bldg:GroundSurface></bldg:boundedBy></bldg:Building>";
+}
+
+/// Runs `doc` serially and cut at every member; both must agree, and the cut run must have read it whole.
+void expect_read_whole_and_same(const std::string& doc, const std::string& why_fragment) {
+  const std::string path = "/vsimem/chunk_fallback.gml";
+  VSILFILE* f = VSIFileFromMemBuffer(path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(doc.data())),
+                                     doc.size(), FALSE);
+  VSIFCloseL(f);
+  const gis::PipelineResult serial = run(path, 1, -1);
+  const gis::PipelineResult cut = run(path, 3, 1);
+  VSIUnlink(path.c_str());
+  EXPECT_EQ(cut.reading.files_chunked, 0u);
+  ASSERT_EQ(cut.reading.read_whole.size(), 1u);
+  EXPECT_NE(cut.reading.read_whole[0].second.find(why_fragment), std::string::npos) << cut.reading.read_whole[0].second;
+  expect_same(serial, cut);
+}
+
+TEST(ChunkedPipeline, StateAcrossMembersMakesTheFileBeReadWhole) {
+  std::vector<std::string> base;
+  for (int i = 0; i < 6; ++i) base.push_back(building("b" + std::to_string(i), 400000 + 30 * i, 5800000));
+  {
+    SCOPED_TRACE("an id in two chunks: DUPLICATE_ID is said by the whole-file reader only");
+    std::vector<std::string> m = base;
+    m[4] = building("b1", 400500, 5800000);
+    expect_read_whole_and_same(citygml_doc(m), "two chunks");
+  }
+  {
+    SCOPED_TRACE("an xlink to another building's polygon");
+    std::vector<std::string> m = base;
+    m[1] = building("b1", 400030, 5800000, "shared-poly");
+    m[4] = "<bldg:Building gml:id=\"b4\"><bldg:lod1MultiSurface xlink:href=\"#shared-poly\"/></bldg:Building>";
+    expect_read_whole_and_same(citygml_doc(m), "xlinks between buildings");
+  }
+  {
+    SCOPED_TRACE("a building without gml:id is named by its line");
+    std::vector<std::string> m = base;
+    m[3] = building("", 400090, 5800000);
+    expect_read_whole_and_same(citygml_doc(m), "without gml:id");
+  }
+  {
+    SCOPED_TRACE("nothing across members: cut");
+    const std::string doc = citygml_doc(base);
+    const std::string path = "/vsimem/chunk_ok.gml";
+    VSILFILE* f = VSIFileFromMemBuffer(path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(doc.data())),
+                                       doc.size(), FALSE);
+    VSIFCloseL(f);
+    const gis::PipelineResult serial = run(path, 1, -1), cut = run(path, 3, 1);
+    VSIUnlink(path.c_str());
+    EXPECT_EQ(cut.reading.chunks, 6u);
+    EXPECT_EQ(serial.footprints.size(), 6u);
+    expect_same(serial, cut);
+  }
+}
+
+}  // namespace
+}  // namespace groundplan
