@@ -1122,14 +1122,23 @@ void add_file_problems(const SourceInfo& info, const std::string& name, std::vec
 }
 }  // namespace detail
 
+namespace {
+struct VsiClose {
+  void operator()(VSILFILE* f) const { VSIFCloseL(f); }
+};
+using VsiHandle = std::unique_ptr<VSILFILE, VsiClose>;
+
+VsiHandle open_file(const std::string& path) {
+  VsiHandle f(VSIFOpenL(path.c_str(), "rb"));
+  if (!f) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+  return f;
+}
+}  // namespace
+
 void read_citygml(const std::string& path, const CityGmlOptions& options, const MeshCallback& on_mesh,
                   std::vector<Problem>& problems, SourceInfo& info) {
-  VSILFILE* fp = VSIFOpenL(path.c_str(), "rb");
-  if (!fp) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
-  struct Closer {
-    VSILFILE* f;
-    ~Closer() { VSIFCloseL(f); }
-  } closer{fp};
+  const VsiHandle file = open_file(path);
+  VSILFILE* fp = file.get();
   Reader reader(path, options, on_mesh, problems, info);
   for (;;) {
     std::size_t n = reader.feed_from([&](void* buf, std::size_t cap) { return VSIFReadL(buf, 1, cap, fp); });
@@ -1157,12 +1166,8 @@ void read_citygml_chunk(const std::string& path, const CityGmlChunkPlan& plan, s
                         SourceInfo& info, CityGmlChunkWatch& watch) {
   const auto [begin, end] = plan.ranges.at(k);
   const bool last = k + 1 == plan.ranges.size();
-  VSILFILE* fp = VSIFOpenL(path.c_str(), "rb");
-  if (!fp) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
-  struct Closer {
-    VSILFILE* f;
-    ~Closer() { VSIFCloseL(f); }
-  } closer{fp};
+  const VsiHandle file = open_file(path);
+  VSILFILE* fp = file.get();
   if (VSIFSeekL(fp, begin, SEEK_SET) != 0) throw InputError(path + ": cannot seek to byte " + std::to_string(begin));
   Reader reader(path, options, on_mesh, problems, info, &watch);
   reader.feed(plan.head.data(), plan.head.size(), false);
