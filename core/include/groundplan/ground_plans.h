@@ -29,7 +29,11 @@ struct UnionParams {
 /// Output rings: outer CCW, holes CW, no repeated points, valid by OGC rules (GEOS isValid).
 /// Members list every footprint index that contributes area to the plan. A footprint with no
 /// usable area (all polygons degenerate) is reported in `problems` (stage "union") and is in no plan.
-/// Throws Cancelled if `progress` asks to stop.
+/// Any footprint is accepted (issue 20): one with a coordinate that is NaN or infinite (`NOT_FINITE`),
+/// or nonzero with a magnitude outside [2^-150, 2^50] m (`COORDINATE_OUT_OF_RANGE`: ±1e300,
+/// subnormals; the range in which the exact predicates are certified) is a Problem naming its
+/// source id and the vertex, and is in no plan; empty footprints, 1- and 2-point rings and repeated
+/// points are allowed. Throws InvalidArgument for bad params, Cancelled if `progress` asks to stop.
 std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footprints, const UnionParams& params,
                                            std::vector<Problem>& problems, const Progress& progress = {});
 

@@ -65,7 +65,8 @@ struct RasterBackend {
                                const PixelGrid& grid) = 0;
 };
 
-/// Builds the set from footprints (drops those without a finite vertex).
+/// Builds the set from footprints (drops those without a vertex, and those with a coordinate the exact
+/// arithmetic refuses: robust/coordinate_range.h).
 FootprintSet make_footprint_set(const std::vector<Footprint>& footprints);
 
 /// The grid over the set. resolution_m > 0 is used as given (coarsened only if the grid would

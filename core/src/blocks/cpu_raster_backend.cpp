@@ -18,6 +18,7 @@
 #include "blocks/cpu_raster_backend.h"
 
 #include "blocks/raster_common.h"
+#include "robust/coordinate_range.h"
 
 #include <groundplan/error.h>
 
@@ -36,10 +37,14 @@ FootprintSet make_footprint_set(const std::vector<Footprint>& footprints) {
   s.footprints = &footprints;
   for (std::uint32_t i = 0; i < footprints.size(); ++i) {
     FootprintSet::Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
+    bool admissible = true;
     for (const Polygon& p : footprints[i].polygons) {
       auto add = [&](const Ring& r) {
         for (const Point2& q : r) {
-          if (!std::isfinite(q.x) || !std::isfinite(q.y)) continue;
+          if (!robust::admissible(q)) {  // NaN, inf, 1e300, subnormal: the union refuses it (issue 20)
+            admissible = false;
+            continue;
+          }
           b.minx = std::min(b.minx, q.x);
           b.miny = std::min(b.miny, q.y);
           b.maxx = std::max(b.maxx, q.x);
@@ -49,7 +54,7 @@ FootprintSet make_footprint_set(const std::vector<Footprint>& footprints) {
       add(p.outer);
       for (const Ring& h : p.holes) add(h);
     }
-    if (b.minx <= b.maxx) {
+    if (admissible && b.minx <= b.maxx) {
       s.indices.push_back(i);
       s.boxes.push_back(b);
     }

@@ -61,24 +61,30 @@ Ring ring_2d(const Mesh& m, std::uint32_t r) {
   return out;
 }
 
-double area_2d(const Ring& r) {
+/// An upper bound of the area the ring covers by the even-odd rule: the sum of the unsigned areas of
+/// its fan triangles from the first vertex. (A point of odd parity has an odd, so nonzero, winding
+/// number, which is the sum of the fan triangles' signed indicators: some triangle covers it.) Unlike
+/// the signed area it is not cancelled by a self-crossing ring: a symmetric bow-tie has signed area 0
+/// but two triangles of area, which the union keeps (issue 20: a self-crossing ring is a footprint,
+/// its region what GEOS MakeValid makes of it). A wall seen edge-on still bounds to ~0.
+double even_odd_area_bound(const Ring& r) {
   if (r.size() < 3) return 0;
   const Point2 o = r[0];
   double a = 0;
   for (std::size_t k = 1; k + 1 < r.size(); ++k)
-    a += (r[k].x - o.x) * (r[k + 1].y - o.y) - (r[k + 1].x - o.x) * (r[k].y - o.y);
+    a += std::fabs((r[k].x - o.x) * (r[k + 1].y - o.y) - (r[k + 1].x - o.x) * (r[k].y - o.y));
   return a / 2;
 }
 
-/// Adds face f as a 2D polygon (holes kept) when its projected outer ring has area. Returns whether.
+/// Adds face f as a 2D polygon (holes kept) when its projected outer ring may have area. Returns whether.
 bool add_face_2d(const Mesh& m, const MeshFace& f, double min_area, std::vector<Polygon>& out) {
   if (f.ring_count == 0) return false;
   Polygon poly;
   poly.outer = ring_2d(m, f.first_ring);
-  if (std::fabs(area_2d(poly.outer)) < min_area) return false;
+  if (even_odd_area_bound(poly.outer) < min_area) return false;  // NaN is kept: the union names it
   for (std::uint32_t r = f.first_ring + 1; r < f.first_ring + f.ring_count; ++r) {
     Ring h = ring_2d(m, r);
-    if (std::fabs(area_2d(h)) >= min_area) poly.holes.push_back(std::move(h));
+    if (even_odd_area_bound(h) >= min_area) poly.holes.push_back(std::move(h));
   }
   out.push_back(std::move(poly));
   return true;

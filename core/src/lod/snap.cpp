@@ -33,11 +33,13 @@
 #include <vector>
 
 #include "lod/ring_geometry.h"
+#include "robust/coordinate_range.h"
 
 namespace groundplan {
 namespace {
 
-bool finite(const Point2& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+// Points the exact arithmetic refuses (NaN, inf, 1e300, subnormal: robust/coordinate_range.h) stay as they are.
+bool finite(const Point2& p) { return robust::admissible(p); }
 
 double dist2(const Point2& a, const Point2& b) {
   const double dx = a.x - b.x, dy = a.y - b.y;

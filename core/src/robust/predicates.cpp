@@ -6,6 +6,7 @@
 #include <mpfr.h>
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 
 namespace groundplan::robust {
@@ -353,7 +354,21 @@ std::vector<std::size_t> nearest_crossings(const Point2& a, const Point2& b, con
   return s;
 }
 
-Point2 crossing_point(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1) {
+Point2 crossing_point(const Point2& a_in, const Point2& b_in, const Point2& f0_in, const Point2& f1_in) {
+  // One crossing, one rounding (issue 20): the walk meets a crossing of edges e and f once along e
+  // and once along f, in either direction, and each time asks for its point. Rounding the same
+  // arithmetic in another operand order gave two doubles a few ulps apart (micro-edges, pieces
+  // joined by a zero-width gap, slivers of overlap between plans). So the operands are put in one
+  // canonical order first: each segment from its lexicographically smaller end, the smaller segment
+  // first. The point is then a function of the two segments alone.
+  auto less = [](const Point2& p, const Point2& q) { return p.x < q.x || (p.x == q.x && p.y < q.y); };
+  Point2 a = a_in, b = b_in, f0 = f0_in, f1 = f1_in;
+  if (less(b, a)) std::swap(a, b);
+  if (less(f1, f0)) std::swap(f0, f1);
+  if (less(f0, a) || (f0 == a && less(f1, b))) {
+    std::swap(a, f0);
+    std::swap(b, f1);
+  }
   using L = long double;
   const L fx = L(f1.x) - L(f0.x), fy = L(f1.y) - L(f0.y);
   const L oa = fx * (L(a.y) - L(f0.y)) - fy * (L(a.x) - L(f0.x));

@@ -79,7 +79,8 @@ std::vector<std::size_t> nearest_crossings(const Point2& a, const Point2& b, con
 
 /// The crossing point of segment a->b with the line f0->f1 (precondition: proper crossing), rounded
 /// to doubles (computed in long double, then clamped into the common bounding box of both segments,
-/// which contains the exact point).
+/// which contains the exact point). The result depends only on the two segments, not on their
+/// order or directions: one crossing is always rounded to the same point (issue 20).
 Point2 crossing_point(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1);
 
 }  // namespace groundplan::robust

@@ -18,56 +18,18 @@
 
 #include "robust/predicates.h"
 #include "union/block_union.h"
+#include "union/input_check.h"
 
 namespace groundplan {
-namespace {
-
-/// True if some ring of some polygon has three non-collinear vertices (exact): the even-odd region
-/// can only have area then.
-bool has_area(const Footprint& f) {
-  for (const Polygon& p : f.polygons) {
-    auto ring = [](const Ring& r) {
-      std::size_t i0 = r.size();
-      for (std::size_t i = 0; i < r.size(); ++i)
-        if (std::isfinite(r[i].x) && std::isfinite(r[i].y)) {
-          i0 = i;
-          break;
-        }
-      if (i0 == r.size()) return false;
-      std::size_t i1 = r.size();
-      for (std::size_t i = i0 + 1; i < r.size(); ++i)
-        if (std::isfinite(r[i].x) && std::isfinite(r[i].y) && !(r[i] == r[i0])) {
-          i1 = i;
-          break;
-        }
-      if (i1 == r.size()) return false;
-      for (std::size_t i = i1 + 1; i < r.size(); ++i)
-        if (std::isfinite(r[i].x) && std::isfinite(r[i].y) && robust::orient(r[i0], r[i1], r[i]) != 0) return true;
-      return false;
-    };
-    if (ring(p.outer)) return true;
-    for (const Ring& h : p.holes)
-      if (ring(h)) return true;
-  }
-  return false;
-}
-
-}  // namespace
-
 std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footprints, const UnionParams& params,
                                            std::vector<Problem>& problems, const Progress& progress) {
   if (params.resolution_m < 0 || !std::isfinite(params.resolution_m))
     throw InvalidArgument("resolution_m must be >= 0 (0 = automatic), got " + std::to_string(params.resolution_m));
   if (params.threads < 0) throw InvalidArgument("threads must be >= 0 (0 = all cores)");
-  // Footprints without area take no part; each is reported (nothing is dropped silently).
+  // Footprints without area or with coordinates the exact arithmetic is not certified for take no
+  // part; each is reported (nothing is dropped silently; issue 20: any input gets an answer).
   std::vector<Footprint> const* src = &footprints;
-  std::vector<char> usable(footprints.size(), 0);
-  for (std::size_t i = 0; i < footprints.size(); ++i) {
-    usable[i] = has_area(footprints[i]);
-    if (!usable[i])
-      problems.push_back(Problem{footprints[i].source_id, footprints[i].source_file, "union", "NO_AREA",
-                                 "the footprint has no area (fewer than three non-collinear points): not in any plan"});
-  }
+  const std::vector<char> usable = detail::usable_footprints(footprints, problems);
   FootprintSet all = make_footprint_set(*src);
   FootprintSet fps;
   fps.footprints = src;

@@ -194,3 +194,39 @@ TEST(ExplicitFootprint, LargeUtmCoordinatesKeepPrecision) {
 
 }  // namespace
 }  // namespace groundplan
+
+namespace groundplan {
+namespace {
+
+// Issue 20: a self-crossing ground ring is a footprint. A symmetric bow-tie has signed area 0; it was
+// dropped as NO_GROUND_GEOMETRY. Its region by the even-odd rule (GEOS MakeValid) is two triangles.
+TEST(ExplicitFootprint, SelfCrossingGroundRingIsAFootprint) {
+  for (SurfaceKind kind : {SurfaceKind::Ground, SurfaceKind::FootPrint}) {
+    Mesh m;
+    m.source_id = "bowtie";
+    m.add_face({{{0, 0, 0}, {10, 10, 0}, {10, 0, 0}, {0, 10, 0}}}, kind, kind == SurfaceKind::Ground ? 2 : 0);
+    FootprintParams explicit_only;
+    explicit_only.source = FootprintSource::GroundSurface;
+    const FootprintResult r = make_footprint(m, explicit_only);
+    ASSERT_TRUE(r.ok) << r.code << ": " << r.reason;
+    ASSERT_EQ(r.footprint.polygons.size(), 1u);
+    EXPECT_EQ(r.footprint.polygons[0].outer.size(), 4u);
+  }
+  // a figure-eight hole in a square stays a hole too
+  Mesh m;
+  m.add_face({{{0, 0, 0}, {20, 0, 0}, {20, 20, 0}, {0, 20, 0}}, {{5, 5, 0}, {15, 15, 0}, {15, 5, 0}, {5, 15, 0}}},
+             SurfaceKind::Ground, 2);
+  const FootprintResult r = make_footprint(m);
+  ASSERT_TRUE(r.ok);
+  ASSERT_EQ(r.footprint.polygons.size(), 1u);
+  EXPECT_EQ(r.footprint.polygons[0].holes.size(), 1u);
+  // a ground face seen edge-on (a wall tagged GroundSurface) still has no area
+  Mesh wall;
+  wall.add_face({{{0, 0, 0}, {10, 0, 0}, {10, 0, 5}, {0, 0, 5}}}, SurfaceKind::Ground, 2);
+  FootprintParams explicit_only;
+  explicit_only.source = FootprintSource::GroundSurface;
+  EXPECT_FALSE(make_footprint(wall, explicit_only).ok);
+}
+
+}  // namespace
+}  // namespace groundplan
