@@ -130,6 +130,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
 
   ReadOptions read_options;
   read_options.lod = options.lod;
+  read_options.lod_refinement = options.lod_refinement;
   read_options.origin = options.origin;
   FootprintParams footprint_params;
   footprint_params.source = to_core(options.footprints);
