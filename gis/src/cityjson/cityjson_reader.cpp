@@ -14,7 +14,9 @@
 #include <cpl_vsi.h>
 #include <simdjson.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 namespace groundplan::gis {
@@ -113,29 +115,37 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
                    std::vector<Problem>& problems, CityJsonInfo& info) {
   info = CityJsonInfo{};
   // The whole file, padded as simdjson needs (GDAL VSI: plain files, /vsigzip/, /vsizip/, /vsimem/).
-  std::string bytes;
+  // One allocation of the stated size (+ padding) when the size is known: on this kind of machine
+  // page faults and copies of a growing buffer cost more than the parse (tests/bench/RESULTS.md).
+  std::unique_ptr<char[]> bytes;
+  std::size_t capacity = 0, length = 0;
   {
     VsiFile holder;
     VSILFILE* f = open_or_throw(path, holder);
     VSIStatBufL st;
-    if (VSIStatL(path.c_str(), &st) == 0 && st.st_size > 0 && static_cast<std::uint64_t>(st.st_size) < simdjson::SIMDJSON_MAXSIZE_BYTES)
-      bytes.reserve(static_cast<std::size_t>(st.st_size) + simdjson::SIMDJSON_PADDING);
-    constexpr std::size_t kChunk = 1 << 20;
+    std::size_t stated = 0;
+    if (VSIStatL(path.c_str(), &st) == 0 && st.st_size > 0 && static_cast<std::uint64_t>(st.st_size) <= simdjson::SIMDJSON_MAXSIZE_BYTES)
+      stated = static_cast<std::size_t>(st.st_size);
+    auto grow = [&](std::size_t want) {
+      std::unique_ptr<char[]> next(new char[want]);
+      if (length) std::memcpy(next.get(), bytes.get(), length);
+      bytes = std::move(next);
+      capacity = want;
+    };
+    grow(stated + simdjson::SIMDJSON_PADDING + 1);  // + 1: the read after the last byte finds the end without growing
     for (;;) {
-      const std::size_t at = bytes.size();
-      if (at > simdjson::SIMDJSON_MAXSIZE_BYTES)
+      if (length > simdjson::SIMDJSON_MAXSIZE_BYTES)
         throw InputError(path + ": larger than 4 GiB, the most a CityJSON file can be read as one document; convert it "
                                 "to CityJSONSeq (cjseq cat, or cjio export jsonl) and read the .city.jsonl");
-      bytes.resize(at + kChunk);
-      const std::size_t got = VSIFReadL(bytes.data() + at, 1, kChunk, f);
-      bytes.resize(at + got);
-      if (got < kChunk) break;
+      if (capacity - length <= simdjson::SIMDJSON_PADDING) grow(std::max<std::size_t>(2 * capacity, 1 << 20));
+      const std::size_t got = VSIFReadL(bytes.get() + length, 1, capacity - length - simdjson::SIMDJSON_PADDING, f);
+      length += got;
+      if (got == 0) break;
     }
   }
-  const std::size_t length = bytes.size();
   info.bytes = length;
-  bytes.resize(length + simdjson::SIMDJSON_PADDING, '\0');
-  const simdjson::padded_string_view json(bytes.data(), length, bytes.size());
+  std::memset(bytes.get() + length, 0, simdjson::SIMDJSON_PADDING);
+  const simdjson::padded_string_view json(bytes.get(), length, capacity);
 
   Transform transform;
   std::unique_ptr<dom::parser> meta_parser = make_dom_parser(options.max_depth);
