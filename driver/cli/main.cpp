@@ -107,6 +107,22 @@ Ogr2ogrArgs split_ogr2ogr_args(const std::vector<std::string>& args) {
   return out;
 }
 
+/// -s_srs / -a_srs name the CRS of the source coordinates (issue 16): ours to apply before the union
+/// (the srsName is wrong or missing), so they are taken out of what goes to GDAL's ogr2ogr, which would
+/// otherwise reproject or relabel our output. The last one given wins.
+std::string take_source_srs(std::vector<std::string>& options) {
+  std::string srs;
+  for (std::size_t i = 0; i + 1 < options.size();) {
+    if (options[i] == "-s_srs" || options[i] == "-a_srs") {
+      srs = options[i + 1];
+      options.erase(options.begin() + static_cast<std::ptrdiff_t>(i), options.begin() + static_cast<std::ptrdiff_t>(i) + 2);
+    } else {
+      ++i;
+    }
+  }
+  return srs;
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -330,10 +346,11 @@ int run(int argc, char** argv) {
     std::cout << app.help();
     return 1;
   }
-  const Ogr2ogrArgs ogr = split_ogr2ogr_args(rest);
+  Ogr2ogrArgs ogr = split_ogr2ogr_args(rest);
 
   PipelineOptions options;
   options.inputs = {ogr.src};
+  options.s_srs = take_source_srs(ogr.options);
   options.union_params.resolution_m = resolution;
   options.union_params.device = groundplan::gis::device_from_string(device);
   options.footprints = groundplan::gis::footprint_mode_from_string(footprints);

@@ -27,6 +27,9 @@ const char* open_option_list_xml() {
          "building), 0..4, or with CityJSON&apos;s refinement (1.2, 1.3, 2.2)' default='-1'/>"
          "  <Option name='T_SRS' type='string' description='Working CRS for the union (projected, metric); default: "
          "the source CRS when projected, else the UTM zone of the data'/>"
+         "  <Option name='S_SRS' type='string' description='CRS of the CityGML/CityJSON coordinates, in place of "
+         "the srsName / referenceSystem the files give (as ogr2ogr -s_srs)'/>"
+         "  <Option name='A_SRS' type='string' description='The same as S_SRS (ogr2ogr -a_srs)'/>"
          "  <Option name='ORIGIN' type='string' description='lon,lat[,alt] (degrees, metres) where a glTF without "
          "georeference or a bare COLLADA file sits'/>"
          "  <Option name='AXIS_ORDER' type='string-select' description='CityGML axis order when a file breaks its "
@@ -93,6 +96,8 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
     o.lod_refinement = lod.refinement;
   }
   if (const char* v = CSLFetchNameValue(open_options, "T_SRS")) o.t_srs = v;
+  if (const char* v = CSLFetchNameValue(open_options, "A_SRS")) o.s_srs = v;
+  if (const char* v = CSLFetchNameValue(open_options, "S_SRS")) o.s_srs = v;
   if (const char* v = CSLFetchNameValue(open_options, "PRESET")) o.detail = gis::lod_preset(v);
   if (const char* v = CSLFetchNameValue(open_options, "RESOLUTION_MODE")) o.detail.raster = gis::raster_mode_from_string(v);
   auto lod_value = [&](const char* name, double* field) {

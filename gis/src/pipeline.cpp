@@ -194,7 +194,11 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
           CrsOptions crs;
           crs.target_srs = working_definition;
           crs.source_axis = options.source_axis;
-          frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
+          frame = std::make_unique<WorkingFrame>(options.s_srs.empty() ? info.citygml.srs_name : options.s_srs, crs, file);
+          if (!options.s_srs.empty())
+            result.problems.push_back({"", file, "georeference", "NOTE",
+                                       "source CRS " + options.s_srs + " from -s_srs/-a_srs (the file says \"" +
+                                           info.citygml.srs_name.substr(0, 200) + "\")"});
         }
         const bool georeferenced = info.in_working_crs || (frame && frame->source_known());
         if (georeferenced && !unknown_frame_file.empty())
@@ -260,6 +264,10 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
     result.buildings_read += given_up.size();
     result.buildings_dropped += given_up.size();
     if (info.in_working_crs) {
+      if (!options.s_srs.empty())
+        result.problems.push_back({"", file, "georeference", "NOTE",
+                                   "-s_srs/-a_srs " + options.s_srs + " is not used for this file: " +
+                                       to_string(info.format) + " is georeferenced in WGS 84 by its own format"});
       for (const std::string& note : info.notes) result.problems.push_back({"", file, "georeference", "NOTE", note});
       if (result.crs_wkt.empty() && info.working_crs.known && unknown_frame_file.empty()) {
         result.crs_wkt = info.working_crs.wkt;

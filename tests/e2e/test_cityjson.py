@@ -40,8 +40,9 @@ def test_cli_file_sequence_and_folder_give_the_same_plans(tmp_path):
 
 def test_driver_and_lod_names(tmp_path):
     out = tmp_path / "d.gpkg"
-    gdal.VectorTranslate(str(out), f"GROUNDPLAN:{BAG_JSON}", format="GPKG", layers=["ground_plans", "problems"],
-                         options="-oo LOD=2.2")
+    src = gdal.OpenEx(f"GROUNDPLAN:{BAG_JSON}", gdal.OF_VECTOR, open_options=["LOD=2.2"])
+    gdal.VectorTranslate(str(out), src, format="GPKG", layers=["ground_plans", "problems"])
+    src = None
     cli = tmp_path / "c.gpkg"
     run([BIN, "--lod", "2.2", "-f", "GPKG", cli, BAG_JSON])
     assert _plans(out) == _plans(cli)
@@ -52,4 +53,9 @@ def test_driver_and_lod_names(tmp_path):
     bad = run([BIN, "--lod", "2.22", "-f", "GPKG", tmp_path / "x.gpkg", BAG_JSON], check=False)
     assert bad.returncode == 1 and "--lod 2.22" in bad.stderr
     with pytest.raises(RuntimeError, match="LOD=7"):
-        gdal.OpenEx(f"GROUNDPLAN:{BAG_JSON}", open_options=["LOD=7"])
+        gdal.OpenEx(f"GROUNDPLAN:{BAG_JSON}", gdal.OF_VECTOR, open_options=["LOD=7"])
+    # LOD=1.3 through the driver: no geometry at that LoD, both buildings are problems.
+    ds = gdal.OpenEx(f"GROUNDPLAN:{BAG_JSON}", gdal.OF_VECTOR, open_options=["LOD=1.3"])
+    assert ds.GetLayerByName("ground_plans").GetFeatureCount() == 0
+    codes = [f.GetField("code") for f in ds.GetLayerByName("problems")]
+    assert codes.count("NO_GEOMETRY_AT_LOD") == 2, codes
