@@ -214,7 +214,9 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
     info.vertices = vertices.size();
     note_bad_vertices(bad_vertices, "\"vertices\"", path, problems);
 
-    doc.rewind();
+    // A second iteration rather than doc.rewind(): UBSan finds rewind() reading a null parser after some
+    // malformed first passes (simdjson 3.0.1); the same parser keeps its buffers, only stage 1 runs again.
+    doc = parser.iterate(json);
     std::unique_ptr<dom::parser> object_parser = make_dom_parser(options.max_depth);
     for (auto field : doc.get_object()) {
       const std::string_view key = field.unescaped_key();
