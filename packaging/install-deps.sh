@@ -13,6 +13,8 @@ packages=(
   libmpfr-dev libgmp-dev
   # formats: streaming XML (CityGML, KML, COLLADA), glTF
   libexpat1-dev libtinygltf-dev
+  # CityJSON / CityJSONSeq (issue 16)
+  libsimdjson-dev
   # CLI parsing, JSON (--stats), thread pool
   libcli11-dev nlohmann-json3-dev libtbb-dev
   # tests and benchmarks

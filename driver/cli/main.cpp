@@ -8,6 +8,7 @@
 
 #include <groundplan/error.h>
 #include <groundplan/gis/geos_reference.h>
+#include <groundplan/gis/lod_choice.h>
 #include <groundplan/gis/pipeline.h>
 
 #include <CLI/CLI.hpp>
@@ -105,6 +106,22 @@ Ogr2ogrArgs split_ogr2ogr_args(const std::vector<std::string>& args) {
     out.layer_named = true;
   }
   return out;
+}
+
+/// -s_srs / -a_srs name the CRS of the source coordinates (issue 16): ours to apply before the union
+/// (the srsName is wrong or missing), so they are taken out of what goes to GDAL's ogr2ogr, which would
+/// otherwise reproject or relabel our output. The last one given wins.
+std::string take_source_srs(std::vector<std::string>& options) {
+  std::string srs;
+  for (std::size_t i = 0; i + 1 < options.size();) {
+    if (options[i] == "-s_srs" || options[i] == "-a_srs") {
+      srs = options[i + 1];
+      options.erase(options.begin() + static_cast<std::ptrdiff_t>(i), options.begin() + static_cast<std::ptrdiff_t>(i) + 2);
+    } else {
+      ++i;
+    }
+  }
+  return srs;
 }
 
 std::string lower(std::string s) {
@@ -285,7 +302,7 @@ int run(int argc, char** argv) {
                                         GDALVersionInfo("RELEASE_NAME") + ")");
   double resolution = 0;
   std::string device = "auto", footprints = "auto", stats_path, preview_path, origin;
-  int lod = -1;
+  std::string lod = "-1";
   bool verify = false;
   app.add_option("--resolution", resolution, "Raster pixel in metres for blocks and seeds (0 = automatic); exact "
                                               "result whatever the value")
@@ -297,7 +314,8 @@ int run(int argc, char** argv) {
   app.add_option("--axis-order", axis_order,
                  "auto|east-north|north-east: CityGML axis order when a file breaks its CRS's rule (e.g. EPSG:4979 "
                  "written lon,lat); auto follows the CRS");
-  app.add_option("--lod", lod, "Level of detail to read (-1 = highest per building)")->check(CLI::Range(-1, 4));
+  app.add_option("--lod", lod, "Level of detail to read: -1 (highest per building), 0..4, or with CityJSON's "
+                               "refinement as 3DBAG names it (1.2, 1.3, 2.2)");
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
   app.add_option("--preview", preview_path, "Write a PNG map of the plans (holes open, problem buildings in red)");
@@ -355,14 +373,17 @@ int run(int argc, char** argv) {
     std::cout << app.help();
     return 1;
   }
-  const Ogr2ogrArgs ogr = split_ogr2ogr_args(rest);
+  Ogr2ogrArgs ogr = split_ogr2ogr_args(rest);
 
   PipelineOptions options;
   options.inputs = {ogr.src};
+  options.s_srs = take_source_srs(ogr.options);
   options.union_params.resolution_m = resolution;
   options.union_params.device = groundplan::gis::device_from_string(device);
   options.footprints = groundplan::gis::footprint_mode_from_string(footprints);
-  options.lod = lod;
+  const groundplan::gis::LodChoice lod_choice = groundplan::gis::parse_lod_choice(lod, "--lod ");
+  options.lod = lod_choice.lod;
+  options.lod_refinement = lod_choice.refinement;
   options.origin = origin;
   options.source_axis = groundplan::gis::axis_order_from_string(axis_order);
   options.detail = groundplan::gis::lod_preset(o_preset->count() ? preset : "none");

@@ -2,6 +2,7 @@
 #include "open_options.h"
 
 #include <groundplan/error.h>
+#include <groundplan/gis/lod_choice.h>
 
 #include <cpl_string.h>
 
@@ -22,10 +23,13 @@ const char* open_option_list_xml() {
          "geometry when present (AUTO), only explicit ground geometry, or surface decomposition' default='AUTO'>"
          "    <Value>AUTO</Value><Value>GROUND-SURFACE</Value><Value>DECOMPOSE</Value>"
          "  </Option>"
-         "  <Option name='LOD' type='int' description='Level of detail to read (-1 = highest available per "
-         "building)' default='-1'/>"
+         "  <Option name='LOD' type='string' description='Level of detail to read: -1 (highest available per "
+         "building), 0..4, or with CityJSON&apos;s refinement (1.2, 1.3, 2.2)' default='-1'/>"
          "  <Option name='T_SRS' type='string' description='Working CRS for the union (projected, metric); default: "
          "the source CRS when projected, else the UTM zone of the data'/>"
+         "  <Option name='S_SRS' type='string' description='CRS of the CityGML/CityJSON coordinates, in place of "
+         "the srsName / referenceSystem the files give (as ogr2ogr -s_srs)'/>"
+         "  <Option name='A_SRS' type='string' description='The same as S_SRS (ogr2ogr -a_srs)'/>"
          "  <Option name='ORIGIN' type='string' description='lon,lat[,alt] (degrees, metres) where a glTF without "
          "georeference or a bare COLLADA file sits'/>"
          "  <Option name='AXIS_ORDER' type='string-select' description='CityGML axis order when a file breaks its "
@@ -89,12 +93,13 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
   if (const char* v = CSLFetchNameValue(open_options, "DEVICE")) o.union_params.device = gis::device_from_string(v);
   if (const char* v = CSLFetchNameValue(open_options, "FOOTPRINTS")) o.footprints = gis::footprint_mode_from_string(v);
   if (const char* v = CSLFetchNameValue(open_options, "LOD")) {
-    const double lod = parse_double("LOD", v);
-    if (lod != static_cast<int>(lod) || lod < -1 || lod > 4)
-      throw InvalidArgument(std::string("open option LOD=") + v + ": must be -1 (highest) or 0..4");
-    o.lod = static_cast<int>(lod);
+    const gis::LodChoice lod = gis::parse_lod_choice(v, "open option LOD=");
+    o.lod = lod.lod;
+    o.lod_refinement = lod.refinement;
   }
   if (const char* v = CSLFetchNameValue(open_options, "T_SRS")) o.t_srs = v;
+  if (const char* v = CSLFetchNameValue(open_options, "A_SRS")) o.s_srs = v;
+  if (const char* v = CSLFetchNameValue(open_options, "S_SRS")) o.s_srs = v;
   if (const char* v = CSLFetchNameValue(open_options, "PRESET")) o.detail = gis::lod_preset(v);
   if (const char* v = CSLFetchNameValue(open_options, "RESOLUTION_MODE")) o.detail.raster = gis::raster_mode_from_string(v);
   auto lod_value = [&](const char* name, double* field) {

@@ -8,6 +8,8 @@
 
 #include <cpl_vsi.h>
 
+#include "cityjson/read_into.h"
+
 #include <algorithm>
 #include <cstring>
 #include <optional>
@@ -18,6 +20,10 @@ namespace {
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
+}
+
+bool ends_with(const std::string& s, std::string_view tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
 std::string extension(const std::string& name) {
@@ -32,7 +38,11 @@ InputFormat sniff(std::string_view head) {
   if (head.size() >= 4 && std::memcmp(head.data(), "glTF", 4) == 0) return InputFormat::Glb;
   const auto first = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
   if (first == std::string_view::npos) return InputFormat::Unknown;
-  if (head[first] == '{') return head.find("\"asset\"") != std::string_view::npos ? InputFormat::Gltf : InputFormat::Unknown;
+  if (head[first] == '{') {
+    bool sequence = false;
+    if (looks_like_cityjson(head, &sequence)) return sequence ? InputFormat::CityJsonSeq : InputFormat::CityJson;
+    return head.find("\"asset\"") != std::string_view::npos ? InputFormat::Gltf : InputFormat::Unknown;
+  }
   if (head[first] != '<') return InputFormat::Unknown;
   if (looks_like_citygml(head)) return InputFormat::CityGml;
   if (head.find("<COLLADA") != std::string_view::npos) return InputFormat::Collada;
@@ -61,6 +71,8 @@ const char* to_string(InputFormat f) {
     case InputFormat::Collada: return "COLLADA";
     case InputFormat::Gltf: return "glTF";
     case InputFormat::Glb: return "GLB";
+    case InputFormat::CityJson: return "CityJSON";
+    case InputFormat::CityJsonSeq: return "CityJSONSeq";
   }
   return "?";
 }
@@ -73,6 +85,8 @@ InputFormat detect_format(const std::string& name, std::string_view head) {
   if (ext == ".dae") return InputFormat::Collada;
   if (ext == ".gltf") return InputFormat::Gltf;
   if (ext == ".glb") return InputFormat::Glb;
+  if (ext == ".jsonl") return InputFormat::CityJsonSeq;  // the reader says when it is not CityJSONSeq
+  if (ends_with(lower(name), ".city.json")) return InputFormat::CityJson;
   const InputFormat by_content = sniff(head);
   if (ext == ".xml" && by_content == InputFormat::Unknown) return InputFormat::CityGml;  // NOT_CITYGML if not
   return by_content;
@@ -80,7 +94,7 @@ InputFormat detect_format(const std::string& name, std::string_view head) {
 
 InputFormat detect_format(const std::string& path) {
   const std::string ext = extension(path);
-  if (!ext.empty() && ext != ".xml") {
+  if (!ext.empty() && ext != ".xml" && ext != ".json") {
     const InputFormat f = detect_format(path, std::string_view());
     if (f != InputFormat::Unknown) return f;
   }
@@ -90,7 +104,7 @@ InputFormat detect_format(const std::string& path) {
 bool is_input_name(const std::string& name) {
   const std::string ext = extension(name);
   return ext == ".gml" || ext == ".citygml" || ext == ".xml" || ext == ".kml" || ext == ".kmz" || ext == ".gltf" ||
-         ext == ".glb";
+         ext == ".glb" || ends_with(lower(name), ".city.json") || ends_with(lower(name), ".city.jsonl");
 }
 
 void read_any(const std::string& path, const ReadOptions& options, const MeshCallback& on_mesh,
@@ -102,7 +116,7 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     VSIStatBufL st;
     if (VSIStatL(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
     throw InputError(path + ": format not recognised (CityGML .gml/.citygml/.xml, KML .kml/.kmz, glTF .gltf/.glb, "
-                            "COLLADA .dae are read)");
+                            "COLLADA .dae, CityJSON .city.json/.json, CityJSONSeq .city.jsonl are read)");
   }
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
@@ -112,6 +126,10 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
       ++info.meshes;
       on_mesh(std::move(m));
     }, problems, info.citygml);
+    return;
+  }
+  if (info.format == InputFormat::CityJson || info.format == InputFormat::CityJsonSeq) {
+    cityjson::read_into(path, options, on_mesh, problems, info);
     return;
   }
 

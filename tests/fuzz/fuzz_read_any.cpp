@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// KML/KMZ + COLLADA and glTF/GLB readers on arbitrary bytes (issue 8), through read_any on a /vsimem/
+// KML/KMZ + COLLADA, glTF/GLB and CityJSON/CityJSONSeq (issue 16) readers on arbitrary bytes (issue 8), through read_any on a /vsimem/
 // file: byte 0 picks the format (the extension), the rest is the file. A .kml may link "m.dae", which
 // is the same bytes again (so COLLADA is reached through KML too). Expected outcomes: meshes,
 // Problems, or an InputError; anything else is a finding.
@@ -25,9 +25,9 @@ void put(const std::string& path, const std::uint8_t* data, std::size_t size) {
 GROUNDPLAN_FUZZ_TARGET(read_any) {
   using namespace groundplan;
   if (size < 1) return 0;
-  static const char* kExt[] = {".kml", ".kmz", ".dae", ".gltf", ".glb"};
+  static const char* kExt[] = {".kml", ".kmz", ".dae", ".gltf", ".glb", ".city.json", ".city.jsonl"};
   const std::string dir = "/vsimem/fuzz_read_any";
-  const std::string path = dir + "/input" + kExt[data[0] % 5];
+  const std::string path = dir + "/input" + kExt[data[0] % 7];
   put(path, data + 1, size - 1);
   put(dir + "/m.dae", data + 1, size - 1);
   gis::ReadOptions options;
@@ -37,6 +37,7 @@ GROUNDPLAN_FUZZ_TARGET(read_any) {
   options.kml.collada.max_vertices = 1 << 16;
   options.gltf.max_bytes = 1 << 20;
   options.gltf.max_vertices = 1 << 16;
+  options.cityjson.max_line_bytes = 1 << 20;
   std::vector<Problem> problems;
   gis::ReadInfo info;
   auto check = [](Mesh&& m) {

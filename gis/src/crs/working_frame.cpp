@@ -174,7 +174,8 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
   if (!options.target_srs.empty()) {
     if (!m.src_known)
       throw InvalidArgument(m.where() + "a target CRS (" + options.target_srs +
-                            ") was asked for, but the source CRS is unknown, so the data cannot be transformed");
+                            ") was asked for, but the source CRS is unknown, so the data cannot be transformed; name it with "
+                            "-s_srs (open option S_SRS)");
     SrsName t = parse_srs_name(options.target_srs);
     m.working = m.create(t.definition);
     if (m.working && proj_get_type(m.working.get()) == PJ_TYPE_COMPOUND_CRS)
@@ -219,13 +220,15 @@ void WorkingFrame::decide(double x, double y) {
       throw InputError(m.where() + "srsName \"" + m.source.text + "\" names a geographic CRS (degrees, " +
                        (north_first ? "latitude first" : "longitude first") + ") but the coordinates read " + fmt(x) +
                        ", " + fmt(y) + ", which are no latitude/longitude: the srsName contradicts the data "
-                       "(projected coordinates under a geographic label?)");
+                       "(projected coordinates under a geographic label?); name the CRS the coordinates are in with "
+                       "-s_srs (open option S_SRS), e.g. -s_srs EPSG:31467");
   }
   PJ_COORD c = proj_coord(x, y, 0, 0);
   PJ_COORD ll = to_ll ? proj_trans(to_ll.get(), PJ_FWD, c) : c;
   if (!to_ll || !std::isfinite(ll.xy.x) || !std::isfinite(ll.xy.y) || std::fabs(ll.xy.y) > 90.0)
     throw InputError(m.where() + "the point " + fmt(x) + ", " + fmt(y) + " is not a valid position in " + m.source.text +
-                     ": the srsName contradicts the data");
+                     ": the srsName contradicts the data; name the CRS the coordinates are in with -s_srs (open "
+                     "option S_SRS)");
   int epsg = utm_epsg_for(ll.xy.x, ll.xy.y);
   m.working.reset(proj_create(m.ctx, ("EPSG:" + std::to_string(epsg)).c_str()));
   if (!m.working) throw Error("PROJ does not know EPSG:" + std::to_string(epsg) + " (is proj.db installed?)");

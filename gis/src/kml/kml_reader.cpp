@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <list>
 #include <optional>
+#include <set>
 
 namespace groundplan::gis {
 namespace {
@@ -127,13 +128,43 @@ class Reader final : public xml::Handler {
       root_dir_ = fs::path(path_).parent_path().string();
       if (root_dir_.empty()) root_dir_ = ".";
     }
-    xml::SafeParser parser(kml_display, *this, opt_.max_xml_depth);
-    xml_ = &parser;
-    xml::parse_vsi_file(info_.kml_path, kml_display, parser, budget_);
-    xml_ = nullptr;
-    if (!saw_kml_root_)
-      throw InputError(kml_display + ": no <kml> root element: not a KML document");
+    visited_.insert(info_.kmz ? info_.kml_path.substr(archive_.size() + 1) : fs::path(path_).filename().string());
+    parse_one(info_.kml_path, kml_display);
+    // NetworkLinks, breadth first: each linked .kml once, hrefs relative to it (issue 16).
+    for (std::size_t i = 0; i < pending_.size(); ++i) {
+      const Link link = pending_[i];
+      const auto slash = link.rel.rfind('/');
+      base_dir_ = slash == std::string::npos ? std::string() : link.rel.substr(0, slash + 1);
+      depth_ = link.depth;
+      ++info_.linked_files;
+      const std::string target = info_.kmz ? archive_ + "/" + link.rel : (fs::path(root_dir_) / link.rel).string();
+      const std::string display = info_.kmz ? path_ + ":" + link.rel : target;
+      try {
+        parse_one(target, display);
+      } catch (const InputError& e) {
+        // A broken tile is that tile's problem; the others are still read (a byte budget overrun is not).
+        if (budget_.used > budget_.max_total_bytes) throw;
+        reset_after_error();
+        problem("", "BAD_NETWORK_LINK_TARGET", std::string(e.what()) + " (linked from " + link.from + ")");
+      }
+    }
     info_.bytes = budget_.used;
+  }
+
+  void parse_one(const std::string& target, const std::string& display) {
+    saw_kml_root_ = false;
+    xml::SafeParser parser(display, *this, opt_.max_xml_depth);
+    xml_ = &parser;
+    xml::parse_vsi_file(target, display, parser, budget_);
+    xml_ = nullptr;
+    if (!saw_kml_root_) throw InputError(display + ": no <kml> root element: not a KML document");
+  }
+
+  void reset_after_error() {
+    xml_ = nullptr;
+    stack_.clear();
+    capturing_ = false;
+    in_placemark_ = in_model_ = in_network_link_ = 0;
   }
 
   void start(std::string_view uri, std::string_view local, const char** atts) override {
@@ -191,11 +222,7 @@ class Reader final : public xml::Handler {
       in_placemark_ = 0;
     } else if (el == "NetworkLink" && in_network_link_ == stack_.size() + 1) {
       in_network_link_ = 0;
-      std::string dummy;
-      const bool remote = resolve_href(nl_href_, base_dir_, dummy) == HrefStatus::Remote;
-      problem(nl_id_, "NETWORK_LINK_NOT_FOLLOWED",
-              std::string("NetworkLink to \"") + nl_href_ + "\" is not followed" +
-                  (remote ? ": remote links are never fetched" : ": NetworkLinks are not read; list the file as an input"));
+      handle_network_link();
     }
     (void)uri;
     (void)local;
@@ -270,6 +297,64 @@ class Reader final : public xml::Handler {
 
   void problem(const std::string& id, const std::string& code, const std::string& reason) {
     problems_.push_back(Problem{id, path_, "read", code, reason});
+  }
+
+  /// A NetworkLink as a viewer follows it, within the input (issue 16). Its problems name no
+  /// building (source_id empty): a link is not a building, and the pipeline counts buildings by id.
+  void handle_network_link() {
+    const std::string where = xml_->name() + (nl_id_.empty() ? "" : " (NetworkLink id \"" + nl_id_.substr(0, 200) + "\")");
+    const std::string quoted = "NetworkLink href \"" + nl_href_.substr(0, 300) + "\" in " + where;
+    std::string rel;
+    switch (resolve_href(nl_href_, base_dir_, rel)) {
+      case HrefStatus::Ok: break;
+      case HrefStatus::Empty: problem("", "NETWORK_LINK_NOT_FOLLOWED", "a NetworkLink without href in " + where); return;
+      case HrefStatus::Remote:
+        problem("", "NETWORK_LINK_NOT_FOLLOWED", quoted + " is a URL: remote files are never fetched");
+        return;
+      case HrefStatus::Absolute:
+        problem("", "LINK_OUTSIDE_INPUT", quoted + " is an absolute path: only paths relative to the KML are followed");
+        return;
+      case HrefStatus::Escapes:
+        problem("", "LINK_OUTSIDE_INPUT", quoted + " climbs out of the " +
+                                              std::string(info_.kmz ? "archive" : "input's folder") + ": not followed");
+        return;
+      case HrefStatus::Invalid: problem("", "BAD_LINK", quoted + " holds control characters: not followed"); return;
+    }
+    if (!ends_with_ci(rel, ".kml")) {
+      problem("", "NETWORK_LINK_NOT_FOLLOWED", quoted + ": only links to .kml files in the same folder tree or archive "
+                                                        "are followed; list other files as inputs");
+      return;
+    }
+    if (depth_ + 1 > opt_.max_network_link_depth) {
+      problem("", "NETWORK_LINK_TOO_DEEP", quoted + ": NetworkLinks nested deeper than " +
+                                               std::to_string(opt_.max_network_link_depth) + " are not followed");
+      return;
+    }
+    if (!visited_.insert(rel).second) {
+      problem("", "NETWORK_LINK_REPEATED", quoted + ": " + rel +
+                                               " is already read (a cycle, or a second link to it): read once");
+      return;
+    }
+    if (pending_.size() >= opt_.max_linked_files) {
+      problem("", "NETWORK_LINK_LIMIT", quoted + ": more than " + std::to_string(opt_.max_linked_files) +
+                                            " linked files; not followed");
+      return;
+    }
+    if (!info_.kmz) {
+      const std::string target = (fs::path(root_dir_) / rel).string();
+      if (!inside_root_on_disk(target)) {
+        problem("", "LINK_OUTSIDE_INPUT", quoted + " resolves (through a symbolic link) outside the input's folder: not followed");
+        return;
+      }
+      if (!vsi_exists(target)) {
+        problem("", "LINK_TARGET_NOT_FOUND", quoted + ": link target not found (looked for " + target + ")");
+        return;
+      }
+    } else if (!vsi_exists(archive_ + "/" + rel)) {
+      problem("", "LINK_TARGET_NOT_FOUND", quoted + ": link target not found in the archive (" + rel + ")");
+      return;
+    }
+    pending_.push_back(Link{rel, depth_ + 1, xml_->name()});
   }
 
   void handle_model() {
@@ -386,6 +471,14 @@ class Reader final : public xml::Handler {
   std::string pm_id_, pm_name_, nl_href_, nl_id_;
   Model model_;
   std::list<std::pair<std::string, Mesh>> cache_;
+  struct Link {
+    std::string rel;   // inside the archive / the input's folder
+    std::size_t depth = 0;
+    std::string from;  // the linking file, for messages
+  };
+  std::vector<Link> pending_;            // NetworkLinks to read, in the order met
+  std::set<std::string> visited_;        // .kml files read or queued (rel paths)
+  std::size_t depth_ = 0;                // NetworkLink depth of the file being parsed
 };
 
 int hex(char c) {

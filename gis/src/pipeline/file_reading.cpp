@@ -87,7 +87,7 @@ class Placer {
         CrsOptions crs;
         crs.target_srs = context_.working_definition;
         crs.source_axis = options_.source_axis;
-        frame_srs = citygml_.srs_name;
+        frame_srs = options_.s_srs.empty() ? citygml_.srs_name : options_.s_srs;  // -s_srs / -a_srs win
         if (kept_ && kept_->frame && kept_->srs == frame_srs)
           frame = std::move(kept_->frame);  // same srsName, options and decision: the same frame
         else
@@ -209,7 +209,7 @@ void append(Part& part, const std::string& file, FileRead& out, Delivered& deliv
 
 /// The file's last words: buildings the reader gave up, notes, and the CRS facts for the pipeline.
 void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info,
-                 const WorkingFrame* frame, const std::string& file) {
+                 const WorkingFrame* frame, const std::string& file, const PipelineOptions& options) {
   // Buildings the reader gave up count as read and dropped: nothing is lost silently. Whatever the
   // format, such a building is named by a read-stage Problem and gave no mesh (a building that did
   // give one may have read-stage defects too: a dropped face, a missing xlink).
@@ -225,11 +225,19 @@ void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info
   out.buildings_dropped += given_up.size();
   out.delivered = std::any_of(delivered.begin(), delivered.end(), [](const auto& set) { return !set.empty(); });
   if (info.in_working_crs) {
+    if (!options.s_srs.empty())
+      out.problems.push_back({"", file, "georeference", "NOTE",
+                              "-s_srs/-a_srs " + options.s_srs + " is not used for this file: " +
+                                  to_string(info.format) + " is georeferenced in WGS 84 by its own format"});
     for (const std::string& note : info.notes) out.problems.push_back({"", file, "georeference", "NOTE", note});
     out.in_working_crs = true;
     out.reader_crs = info.working_crs;
   }
   if (frame) {
+    if (!options.s_srs.empty())
+      out.problems.push_back({"", file, "georeference", "NOTE",
+                              "source CRS " + options.s_srs + " from -s_srs/-a_srs (the file says \"" +
+                                  info.citygml.srs_name.substr(0, 200) + "\")"});
     for (const std::string& note : frame->notes()) out.problems.push_back({"", file, "georeference", "NOTE", note});
     out.has_frame = true;
     out.frame_source_known = frame->source_known();
@@ -245,6 +253,7 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
   ReadInfo info;
   ReadOptions read_options;
   read_options.lod = options.lod;
+  read_options.lod_refinement = options.lod_refinement;
   read_options.origin = options.origin;
   read_options.target_srs = context.working_definition;  // KML/glTF are placed by the reader, in this CRS
   bool counted_bytes = false;
@@ -284,7 +293,7 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
   }
   Delivered delivered;
   append(part, file, out, delivered);
-  finish_file(out, delivered, info, placer.frame.get(), file);
+  finish_file(out, delivered, info, placer.frame.get(), file, options);
   return out;
 }
 
@@ -362,7 +371,8 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
   out.problems.insert(out.problems.end(), file_problems.begin(), file_problems.end());
   ReadInfo info;
   info.citygml = merged;
-  finish_file(out, delivered, info, first ? first->frame.get() : nullptr, file);
+  info.format = InputFormat::CityGml;
+  finish_file(out, delivered, info, first ? first->frame.get() : nullptr, file, options);
   out.chunks = n;
   return out;
 }

@@ -10,7 +10,10 @@
 //
 // Security: nothing is fetched. http(s)/ftp/file URLs, absolute paths and hrefs that climb out of
 // the archive (or out of the .kml's folder; symlinks included) are Problems, never opened.
-// NetworkLinks are Problems (not followed). Unpacked bytes are bounded per entry and per input
+// NetworkLinks to .kml files are followed as a viewer would (issue 16): hrefs relative to the
+// linking file ('\' taken as '/'), inside the input's folder or archive only, depth-limited, each
+// file read once (cycles and repeated links are reported, not followed); remote, absolute and
+// escaping links are Problems, never opened. Unpacked bytes are bounded per entry and per input
 // (zip bombs: the stated size is checked before reading, the bytes read while reading). XML as in
 // the other readers: no DTD, no entities, depth limit.
 #include <groundplan/gis/collada.h>
@@ -30,6 +33,8 @@ struct KmlOptions {
   std::uint64_t max_entry_bytes = std::uint64_t{256} << 20;  // one .kml / .dae, unpacked
   std::uint64_t max_total_bytes = std::uint64_t{1} << 30;    // everything read for one input
   std::size_t max_xml_depth = 256;
+  std::size_t max_network_link_depth = 32;   // NetworkLink chains deeper than this: NETWORK_LINK_TOO_DEEP
+  std::size_t max_linked_files = 100000;     // .kml files read through NetworkLinks, per input
 };
 
 struct KmlInfo {
@@ -39,7 +44,8 @@ struct KmlInfo {
   std::size_t placemarks = 0;
   std::size_t models = 0;        // <Model> elements met
   std::size_t meshes = 0;        // models delivered
-  std::size_t network_links = 0; // NetworkLinks met (never followed)
+  std::size_t network_links = 0; // NetworkLinks met
+  std::size_t linked_files = 0;  // .kml files read through NetworkLinks
   std::uint64_t bytes = 0;       // unpacked bytes read (KML + COLLADA)
 };
 
@@ -50,7 +56,8 @@ struct KmlInfo {
 using KmlModelCallback = std::function<void(Mesh&&, const ModelPlacement&)>;
 
 /// Reads a .kml or .kmz (local or VSI path). Per-model defects (no Location, unreadable or missing
-/// COLLADA: code LINK_TARGET_NOT_FOUND, remote or escaping href, NetworkLink) are Problems and
+/// COLLADA: code LINK_TARGET_NOT_FOUND, remote or escaping href, NetworkLink not followed, linked
+/// .kml unreadable: BAD_NETWORK_LINK_TARGET) are Problems and
 /// reading goes on. Throws InputError naming the file when the file cannot be read, is not a zip
 /// (.kmz) or holds no .kml, is not well-formed XML, or passes the byte limits. Exceptions thrown
 /// by `on_model` propagate.

@@ -21,6 +21,9 @@ struct PipelineOptions {
   std::vector<std::string> inputs;  // files or folders (a folder: its CityGML, KML/KMZ, glTF files, sorted by name)
   FootprintMode footprints = FootprintMode::Auto;
   int lod = -1;                     // -1 = the highest LoD each building has
+  int lod_refinement = -1;          // CityJSON "2.2": the digit after the point (gis/lod_choice.h); -1 = highest
+  std::string s_srs;                // -s_srs / -a_srs, S_SRS= / A_SRS=: the CRS of CityGML/CityJSON coordinates, in
+                                    // place of what the files say (srsName, referenceSystem); empty = the files'
   std::string t_srs;                // working CRS as the user names it (EPSG:n, WKT, PROJ string); empty = automatic
   std::string origin;               // "lon,lat[,alt]": where a glTF without georeference or a bare .dae sits; empty = none
   AxisOrder source_axis = AxisOrder::Auto;  // CityGML: axis order of the coordinates when a file breaks its CRS's

@@ -7,9 +7,12 @@
 //   .kml .kmz              KML + COLLADA  meshes in the working CRS (placed with GeographicLib + PROJ)
 //   .gltf .glb             glTF           meshes in the working CRS (ECEF georeference, else origin)
 //   .dae                   COLLADA alone  meshes in the working CRS; needs ReadOptions::origin
+//   .city.json, .json      CityJSON       as CityGML: meshes as written, CRS in info.citygml.srs_name
+//   .city.jsonl, .jsonl    CityJSONSeq    (metadata.referenceSystem); .json only with "type": "CityJSON"
 // The working CRS of self-georeferenced formats is ReadOptions::target_srs when given, else the
 // WGS 84 UTM zone of the first model's anchor; it is in info.working_crs once a mesh was placed.
 #include <groundplan/gis/citygml.h>
+#include <groundplan/gis/cityjson.h>
 #include <groundplan/gis/crs.h>
 #include <groundplan/gis/gltf.h>
 #include <groundplan/gis/kml.h>
@@ -24,16 +27,18 @@
 
 namespace groundplan::gis {
 
-enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb };
+enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb, CityJson, CityJsonSeq };
 const char* to_string(InputFormat format);
 
 struct ReadOptions {
-  int lod = -1;                 // CityGML: -1 = the highest LoD each building has
+  int lod = -1;                 // CityGML, CityJSON: -1 = the highest LoD each building has
+  int lod_refinement = -1;      // CityJSON: with lod, the digit after the point (3DBAG "2.2"); -1 = the highest
   std::string target_srs;       // working CRS for KML/glTF/COLLADA (-t_srs, or the first file's); empty = UTM
   std::string origin;           // "lon,lat[,alt]" for glTF without georeference and bare .dae; empty = none
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
   std::function<void(std::uint64_t)> on_bytes;  // CityGML: told the bytes as they are read (progress); may be empty
+  CityJsonOptions cityjson;     // limits (lod and lod_refinement above win over its own)
 };
 
 struct ReadInfo {
@@ -42,7 +47,8 @@ struct ReadInfo {
   bool in_working_crs = false;  // meshes arrive in working_crs (KML, glTF, COLLADA); false: as written (CityGML)
   WorkingCrs working_crs;       // valid when in_working_crs and something was placed
   std::vector<std::string> notes;  // georeference notes (UTM zone chosen ...)
-  SourceInfo citygml;           // CityGML only
+  SourceInfo citygml;           // CityGML; for CityJSON: srs_name (referenceSystem), envelope (geographicalExtent)
+  CityJsonInfo cityjson;        // CityJSON / CityJSONSeq only
   KmlInfo kml;                  // KML/KMZ only
   GltfInfo gltf;                // glTF only
   std::size_t meshes = 0;       // meshes delivered
@@ -53,8 +59,9 @@ struct ReadInfo {
 InputFormat detect_format(const std::string& path);
 /// The same from a file name and its first bytes (for a driver's Identify). Does not throw.
 InputFormat detect_format(const std::string& name, std::string_view head);
-/// True for the extensions a folder of tiles is expanded to (.gml .citygml .xml .kml .kmz .gltf .glb;
-/// not .dae: a .dae beside a .kml is the KML's model, not a second input).
+/// True for the extensions a folder of tiles is expanded to (.gml .citygml .xml .kml .kmz .gltf .glb
+/// .city.json .city.jsonl; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
+/// plain .json: a tile folder holds other JSON, e.g. 3D Tiles' tileset.json).
 bool is_input_name(const std::string& name);
 
 /// Reads one file of any supported format. `info.format` and `info.in_working_crs` are set before

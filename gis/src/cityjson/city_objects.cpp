@@ -1,0 +1,432 @@
+// SPDX-License-Identifier: MIT
+// City object -> Mesh (issue 16). CityJSON boundaries are nested arrays of vertex indices whose depth
+// the geometry type fixes (CityJSON 2.0 spec §3.3): MultiSurface/CompositeSurface [surface][ring][i],
+// Solid [shell][surface][ring][i], MultiSolid/CompositeSolid [solid][shell][surface][ring][i];
+// "semantics.values" mirrors boundaries down to the surface and holds an index into
+// "semantics.surfaces" (or null). A GeometryInstance places a template: vertex = M * template vertex
+// + the instance's reference point (its one boundary index).
+#include "cityjson/city_objects.h"
+
+#include <groundplan/error.h>
+
+#include <cmath>
+#include <optional>
+#include <utility>
+
+namespace groundplan::gis::cityjson {
+namespace {
+
+namespace dom = simdjson::dom;
+
+SurfaceKind kind_of(std::string_view type) {
+  if (type == "GroundSurface") return SurfaceKind::Ground;
+  if (type == "RoofSurface") return SurfaceKind::Roof;
+  if (type == "WallSurface") return SurfaceKind::Wall;
+  if (type == "ClosureSurface") return SurfaceKind::Closure;
+  return SurfaceKind::Other;
+}
+
+/// Surface levels above a surface in "boundaries" (and "semantics.values"); -1: not a surface type.
+int surface_levels(std::string_view type) {
+  if (type == "MultiSurface" || type == "CompositeSurface") return 1;
+  if (type == "Solid") return 2;
+  if (type == "MultiSolid" || type == "CompositeSolid") return 3;
+  return -1;
+}
+
+/// "lod": "2", "2.2" (1.1, 2.0) or a number 2, 1.2 (1.0). major 0..4, minor 0..9.
+bool parse_lod(dom::element e, int& major, int& minor) {
+  std::string_view s;
+  double d = 0;
+  if (e.get_string().get(s) == simdjson::SUCCESS) {
+    if (s.size() == 1 && s[0] >= '0' && s[0] <= '4') {
+      major = s[0] - '0';
+      minor = 0;
+      return true;
+    }
+    if (s.size() == 3 && s[0] >= '0' && s[0] <= '4' && s[1] == '.' && s[2] >= '0' && s[2] <= '9') {
+      major = s[0] - '0';
+      minor = s[2] - '0';
+      return true;
+    }
+    return false;
+  }
+  if (e.get_double().get(d) != simdjson::SUCCESS || !(d >= 0 && d < 5)) return false;
+  major = static_cast<int>(d);
+  minor = static_cast<int>(std::lround((d - major) * 10));
+  if (minor > 9) return false;
+  return true;
+}
+
+/// Defects of one object: one Problem per code, with the count and the first case.
+struct Defects {
+  struct Entry {
+    std::string code, first;
+    std::size_t count = 0;
+  };
+  std::vector<Entry> entries;
+  void add(const char* code, std::string reason) {
+    for (Entry& e : entries)
+      if (e.code == code) {
+        ++e.count;
+        return;
+      }
+    entries.push_back(Entry{code, std::move(reason), 1});
+  }
+};
+
+/// Where a geometry's indices point, and how its vertices are placed (templates).
+struct VertexSource {
+  const std::vector<Point3>* points = nullptr;
+  const double* matrix = nullptr;  // row-major 4x4 (GeometryInstance), or none
+  Point3 ref;
+};
+
+class GeometryWalker {
+ public:
+  GeometryWalker(const VertexSource& src, const std::vector<SurfaceKind>& kinds, std::uint8_t lod, double max_abs,
+                 Mesh& mesh, Defects& defects)
+      : src_(src), kinds_(kinds), lod_(lod), max_abs_(max_abs), mesh_(mesh), defects_(defects) {}
+
+  void walk(dom::element boundaries, std::optional<dom::element> values, int levels) {
+    if (levels == 0) {
+      SurfaceKind kind = SurfaceKind::Unknown;
+      std::uint64_t k = 0;
+      if (values && values->get_uint64().get(k) == simdjson::SUCCESS) {
+        if (k < kinds_.size())
+          kind = kinds_[k];
+        else
+          defects_.add("BAD_SEMANTICS", "semantics value " + std::to_string(k) + " has no surface (" +
+                                            std::to_string(kinds_.size()) + " declared)");
+      }
+      surface(boundaries, kind);
+      return;
+    }
+    dom::array children = boundaries.get_array();
+    dom::array value_children;
+    const bool have_values = values && values->get_array().get(value_children) == simdjson::SUCCESS;
+    std::size_t i = 0;
+    for (dom::element child : children) {
+      std::optional<dom::element> v;
+      dom::element ve;
+      if (have_values && value_children.at(i).get(ve) == simdjson::SUCCESS) v = ve;
+      walk(child, v, levels - 1);
+      ++i;
+    }
+  }
+
+ private:
+  bool vertex(std::uint64_t index, Point3& out, std::string& why) const {
+    if (index >= src_.points->size()) {
+      why = "BAD_VERTEX_INDEX";
+      return false;
+    }
+    Point3 p = (*src_.points)[index];
+    if (src_.matrix) {
+      const double* m = src_.matrix;
+      p = Point3{m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] + src_.ref.x,
+                 m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7] + src_.ref.y,
+                 m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11] + src_.ref.z};
+    }
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      why = "NOT_FINITE";
+      return false;
+    }
+    if (std::fabs(p.x) > max_abs_ || std::fabs(p.y) > max_abs_ || std::fabs(p.z) > max_abs_) {
+      why = "COORDINATE_OUT_OF_RANGE";
+      return false;
+    }
+    out = p;
+    return true;
+  }
+
+  void surface(dom::element s, SurfaceKind kind) {
+    rings_.clear();
+    std::size_t ring_no = 0;
+    for (dom::element ring : s.get_array()) {
+      std::vector<Point3> pts;
+      for (dom::element idx : ring.get_array()) {
+        std::uint64_t i = 0;
+        std::string why;
+        Point3 p;
+        if (idx.get_uint64().get(i) != simdjson::SUCCESS) {
+          defects_.add("BAD_VERTEX_INDEX", "a vertex index is not a non-negative integer; its surface is dropped");
+          return;
+        }
+        if (!vertex(i, p, why)) {
+          if (why == "BAD_VERTEX_INDEX")
+            defects_.add("BAD_VERTEX_INDEX", "vertex index " + std::to_string(i) + " is out of range (" +
+                                                 std::to_string(src_.points->size()) +
+                                                 " vertices); its surface is dropped");
+          else if (why == "NOT_FINITE")
+            defects_.add("NOT_FINITE", "vertex " + std::to_string(i) +
+                                           " is not three finite numbers; its surface is dropped");
+          else
+            defects_.add("COORDINATE_OUT_OF_RANGE", "vertex " + std::to_string(i) + " lies beyond " +
+                                                        std::to_string(max_abs_) + "; its surface is dropped");
+          return;
+        }
+        pts.push_back(p);
+      }
+      if (pts.size() < 3) {
+        defects_.add("TOO_FEW_POINTS", std::string("a ") + (ring_no == 0 ? "surface's outer ring" : "hole") + " has " +
+                                           std::to_string(pts.size()) + " vertices (< 3); it is dropped");
+        if (ring_no == 0) return;
+      } else {
+        rings_.push_back(std::move(pts));
+      }
+      ++ring_no;
+    }
+    if (rings_.empty()) {
+      defects_.add("TOO_FEW_POINTS", "a surface has no ring; it is dropped");
+      return;
+    }
+    mesh_.add_face(rings_, kind, lod_);
+  }
+
+  const VertexSource& src_;
+  const std::vector<SurfaceKind>& kinds_;
+  std::uint8_t lod_;
+  double max_abs_;
+  Mesh& mesh_;
+  Defects& defects_;
+  std::vector<std::vector<Point3>> rings_;
+};
+
+std::vector<SurfaceKind> semantic_kinds(dom::element geometry, std::optional<dom::element>& values) {
+  std::vector<SurfaceKind> kinds;
+  dom::element sem;
+  if (geometry["semantics"].get(sem) != simdjson::SUCCESS || sem.is_null()) return kinds;
+  dom::element surfaces;
+  if (sem["surfaces"].get(surfaces) == simdjson::SUCCESS)
+    for (dom::element s : surfaces.get_array()) {
+      std::string_view t;
+      kinds.push_back(s["type"].get(t) == simdjson::SUCCESS ? kind_of(t) : SurfaceKind::Other);
+    }
+  dom::element v;
+  if (sem["values"].get(v) == simdjson::SUCCESS) values = v;
+  return kinds;
+}
+
+/// A geometry with its LoD, resolved through a template where it is a GeometryInstance.
+struct Candidate {
+  dom::element geometry;  // the surface geometry (the template for an instance)
+  int levels = 0;
+  int major = 0, minor = 0;
+  bool instance = false;
+  double matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  std::uint64_t ref_index = 0;
+  int rank() const { return major * 10 + minor; }
+};
+
+}  // namespace
+
+Transform parse_transform(dom::element e, const std::string& file) {
+  Transform t;
+  try {
+    dom::array scale = e["scale"].get_array();
+    dom::array translate = e["translate"].get_array();
+    if (scale.size() != 3 || translate.size() != 3) throw InputError(file + ": \"transform\" needs 3 scale and 3 translate values");
+    for (std::size_t i = 0; i < 3; ++i) {
+      t.scale[i] = scale.at(i).get_double();
+      t.translate[i] = translate.at(i).get_double();
+      if (!std::isfinite(t.scale[i]) || !std::isfinite(t.translate[i]) || t.scale[i] == 0)
+        throw InputError(file + ": \"transform\" has a zero or non-finite value");
+    }
+  } catch (const simdjson::simdjson_error& err) {
+    throw InputError(file + ": \"transform\" is not {\"scale\": [3 numbers], \"translate\": [3 numbers]} (" +
+                     err.what() + ")");
+  }
+  t.present = true;
+  return t;
+}
+
+Templates parse_templates(dom::element e, const std::string& file, std::vector<Problem>& problems) {
+  Templates t;
+  try {
+    for (dom::element g : e["templates"].get_array()) t.geometries.push_back(g);
+    for (dom::element v : e["vertices-templates"].get_array()) {
+      dom::array a = v.get_array();
+      double xyz[3] = {NAN, NAN, NAN};
+      bool ok = a.size() == 3;
+      for (std::size_t i = 0; ok && i < 3; ++i) ok = a.at(i).get_double().get(xyz[i]) == simdjson::SUCCESS;
+      t.vertices.push_back(ok ? Point3{xyz[0], xyz[1], xyz[2]} : Point3{NAN, NAN, NAN});
+    }
+  } catch (const simdjson::simdjson_error& err) {
+    problems.push_back(Problem{"", file, "read", "BAD_TEMPLATES",
+                               std::string("\"geometry-templates\" is malformed (") + err.what() +
+                                   "); GeometryInstances using it are dropped"});
+  }
+  return t;
+}
+
+void add_vertex(std::vector<Point3>& out, const double* xyz, bool ok, const Transform& t, std::size_t& bad) {
+  if (!ok) {
+    ++bad;
+    out.push_back(Point3{NAN, NAN, NAN});
+    return;
+  }
+  out.push_back(Point3{xyz[0] * t.scale[0] + t.translate[0], xyz[1] * t.scale[1] + t.translate[1],
+                       xyz[2] * t.scale[2] + t.translate[2]});
+}
+
+void ObjectConverter::convert(std::string_view id_view, dom::element object, const std::vector<Point3>& vertices,
+                              const Templates& templates) {
+  ++info_.city_objects;
+  const std::string id(id_view.substr(0, 256));
+  std::string_view type;
+  dom::element type_el;
+  if (object["type"].get(type_el) != simdjson::SUCCESS || type_el.get_string().get(type) != simdjson::SUCCESS) {
+    problems_.push_back(Problem{id, file_, "read", "BAD_CITYOBJECT", "city object \"" + id + "\" has no \"type\"; skipped"});
+    return;
+  }
+  const bool part = type == "BuildingPart";
+  if (type != "Building" && !part) return;  // other city objects are not buildings
+  ++(part ? info_.building_parts : info_.buildings);
+
+  Mesh mesh;
+  mesh.source_id = id;
+  mesh.source_file = file_;
+  Defects defects;
+  bool has_children = false;
+  std::string skipped_types;  // geometry types that are not surfaces (MultiPoint, MultiLineString)
+  std::vector<Candidate> candidates;
+  try {
+    dom::element el;
+    dom::array arr;
+    if (part && object["parents"].get(el) == simdjson::SUCCESS && el.get_array().get(arr) == simdjson::SUCCESS &&
+        arr.size() > 0) {
+      std::string_view parent;
+      if (arr.at(0).get_string().get(parent) == simdjson::SUCCESS) mesh.parent_id = std::string(parent.substr(0, 256));
+    }
+    if (object["children"].get(el) == simdjson::SUCCESS && el.get_array().get(arr) == simdjson::SUCCESS)
+      has_children = arr.size() > 0;
+    double h = 0;
+    if (object["attributes"].get(el) == simdjson::SUCCESS && el["measuredHeight"].get_double().get(h) == simdjson::SUCCESS &&
+        std::isfinite(h))
+      mesh.measured_height = h;
+    if (object["geometry"].get(el) == simdjson::SUCCESS && el.get_array().get(arr) == simdjson::SUCCESS) {
+      for (dom::element g : arr) {
+        try {
+          Candidate c;
+          std::string_view gtype = g["type"].get_string();
+          dom::element lod_el;
+          dom::element surface_geometry = g;
+          if (gtype == "GeometryInstance") {
+            const std::uint64_t tpl = g["template"].get_uint64();
+            if (tpl >= templates.geometries.size()) {
+              defects.add("BAD_TEMPLATE", "GeometryInstance names template " + std::to_string(tpl) + " of " +
+                                              std::to_string(templates.geometries.size()) + "; it is dropped");
+              continue;
+            }
+            surface_geometry = templates.geometries[tpl];
+            gtype = surface_geometry["type"].get_string();
+            dom::array m = g["transformationMatrix"].get_array();
+            if (m.size() != 16) {
+              defects.add("BAD_TEMPLATE", "a GeometryInstance's transformationMatrix does not have 16 values; dropped");
+              continue;
+            }
+            for (std::size_t i = 0; i < 16; ++i) c.matrix[i] = m.at(i).get_double();
+            dom::array b = g["boundaries"].get_array();
+            if (b.size() != 1) {
+              defects.add("BAD_TEMPLATE", "a GeometryInstance's boundaries must hold one reference vertex; dropped");
+              continue;
+            }
+            c.ref_index = b.at(0).get_uint64();
+            c.instance = true;
+          }
+          c.geometry = surface_geometry;
+          c.levels = surface_levels(gtype);
+          if (c.levels < 0) {
+            if (skipped_types.find(gtype) == std::string::npos)
+              skipped_types += (skipped_types.empty() ? "" : ", ") + std::string(gtype.substr(0, 40));
+            continue;
+          }
+          if (surface_geometry["lod"].get(lod_el) != simdjson::SUCCESS || !parse_lod(lod_el, c.major, c.minor)) {
+            defects.add("BAD_LOD", "a " + std::string(gtype) + " has no valid \"lod\" (\"0\"..\"4\" or \"2.2\" ...); "
+                                   "it is dropped");
+            continue;
+          }
+          candidates.push_back(c);
+        } catch (const simdjson::simdjson_error& err) {
+          defects.add("BAD_GEOMETRY", std::string("a geometry is malformed (") + err.what() + "); it is dropped");
+        }
+      }
+    }
+  } catch (const simdjson::simdjson_error& err) {
+    defects.add("BAD_CITYOBJECT", std::string("the object is malformed (") + err.what() + ")");
+  }
+
+  auto report_defects = [&] {
+    for (const Defects::Entry& e : defects.entries)
+      problems_.push_back(Problem{id, file_, "read", e.code,
+                                  e.count == 1 ? e.first : e.first + " (and " + std::to_string(e.count - 1) + " more)"});
+  };
+  auto give_up = [&](const char* code, const std::string& reason) {
+    report_defects();
+    problems_.push_back(Problem{id, file_, "read", code, reason});
+    ++info_.buildings_dropped;
+  };
+
+  // LoD choice: the highest the object has, or the one asked for (refinement: "2.2" of LoD 2).
+  int best = -1;
+  std::string available;
+  for (const Candidate& c : candidates) {
+    const std::string name = std::to_string(c.major) + (c.minor ? "." + std::to_string(c.minor) : "");
+    if (available.find(name) == std::string::npos) available += (available.empty() ? "" : ", ") + name;
+    if (opt_.lod >= 0 && (c.major != opt_.lod || (opt_.lod_refinement >= 0 && c.minor != opt_.lod_refinement))) continue;
+    best = std::max(best, c.rank());
+  }
+  if (candidates.empty()) {
+    if (has_children && defects.entries.empty() && skipped_types.empty()) return;  // its parts carry it
+    std::string reason = std::string(part ? "BuildingPart" : "Building") + " \"" + id + "\" has no surface geometry";
+    if (!skipped_types.empty()) reason += " (only " + skipped_types + ")";
+    if (!defects.entries.empty()) reason += " left after the defects above";
+    give_up("NO_GEOMETRY", reason);
+    return;
+  }
+  if (best < 0) {
+    if (has_children) {
+      report_defects();
+      return;
+    }
+    const std::string want = std::to_string(opt_.lod) + (opt_.lod_refinement >= 0 ? "." + std::to_string(opt_.lod_refinement) : "");
+    give_up("NO_GEOMETRY_AT_LOD", "no geometry at LoD " + want + " (the object has LoD " + available + ")");
+    return;
+  }
+
+  for (const Candidate& c : candidates) {
+    if (c.rank() != best) continue;
+    try {
+      VertexSource src;
+      src.points = &vertices;
+      if (c.instance) {
+        if (c.ref_index >= vertices.size() || !std::isfinite(vertices[c.ref_index].x)) {
+          defects.add("BAD_VERTEX_INDEX", "a GeometryInstance's reference vertex " + std::to_string(c.ref_index) +
+                                              " is out of range or not finite; it is dropped");
+          continue;
+        }
+        src.points = &templates.vertices;
+        src.matrix = c.matrix;
+        src.ref = vertices[c.ref_index];
+      }
+      std::optional<dom::element> values;
+      const std::vector<SurfaceKind> kinds = semantic_kinds(c.geometry, values);
+      GeometryWalker walker(src, kinds, static_cast<std::uint8_t>(c.major), opt_.max_abs_coordinate, mesh, defects);
+      walker.walk(c.geometry["boundaries"], values, c.levels);
+    } catch (const simdjson::simdjson_error& err) {
+      defects.add("BAD_GEOMETRY", std::string("a geometry's boundaries are malformed (") + err.what() +
+                                      "); what was read of it is kept");
+    }
+  }
+  if (mesh.faces.empty()) {
+    give_up("NO_GEOMETRY", std::string(part ? "BuildingPart" : "Building") + " \"" + id +
+                               "\" has no usable surface left after the defects above");
+    return;
+  }
+  report_defects();
+  ++info_.meshes;
+  on_mesh_(std::move(mesh));
+}
+
+}  // namespace groundplan::gis::cityjson

@@ -1,0 +1,384 @@
+// SPDX-License-Identifier: MIT
+// CityJSON and CityJSONSeq front ends (issue 16). Why simdjson: reading must beat GML by a wide margin
+// (>= 200 MB/s per core); simdjson's On-Demand walks the file without building a DOM, so the file's
+// bytes and its structural index are all it holds. CityJSON puts "vertices" anywhere among the
+// top-level keys (usually after "CityObjects"), so the file is walked twice: the first pass takes
+// transform, metadata, templates and vertices, the second hands each city object's text to a small
+// DOM parser (bounded by that object), so one malformed object is a Problem, not the file's end.
+// CityJSONSeq (one JSON document per line) is read line by line through a bounded buffer.
+#include <groundplan/error.h>
+#include <groundplan/gis/cityjson.h>
+
+#include "cityjson/city_objects.h"
+
+#include <cpl_vsi.h>
+#include <simdjson.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+namespace groundplan::gis {
+namespace {
+
+namespace dom = simdjson::dom;
+namespace ondemand = simdjson::ondemand;
+using cityjson::ObjectConverter;
+using cityjson::Templates;
+using cityjson::Transform;
+
+struct VsiFile {
+  VSILFILE* f = nullptr;
+  ~VsiFile() {
+    if (f) VSIFCloseL(f);
+  }
+};
+
+VSILFILE* open_or_throw(const std::string& path, VsiFile& holder) {
+  holder.f = VSIFOpenL(path.c_str(), "rb");
+  if (!holder.f) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+  return holder.f;
+}
+
+void read_metadata(dom::element meta, CityJsonInfo& info) {
+  std::string_view rs;
+  if (meta["referenceSystem"].get_string().get(rs) == simdjson::SUCCESS) info.reference_system = std::string(rs.substr(0, 4096));
+  dom::array ext;
+  if (meta["geographicalExtent"].get_array().get(ext) == simdjson::SUCCESS && ext.size() == 6) {
+    bool ok = true;
+    for (std::size_t i = 0; i < 6 && ok; ++i) ok = ext.at(i).get_double().get(info.extent[i]) == simdjson::SUCCESS;
+    info.has_extent = ok;
+  }
+}
+
+/// A fresh DOM parser limited to `max_depth` nesting.
+std::unique_ptr<dom::parser> make_dom_parser(std::size_t max_depth) {
+  auto p = std::make_unique<dom::parser>();
+  if (p->allocate(1 << 16, max_depth) != simdjson::SUCCESS) throw std::bad_alloc();
+  return p;
+}
+
+/// Vertices of a DOM array ("vertices" of a CityJSONSeq feature).
+void read_vertices(dom::array a, const Transform& t, std::vector<Point3>& out, std::size_t& bad) {
+  out.clear();
+  out.reserve(a.size());
+  for (dom::element v : a) {
+    double xyz[3] = {0, 0, 0};
+    dom::array c;
+    bool ok = v.get_array().get(c) == simdjson::SUCCESS && c.size() == 3;
+    for (std::size_t i = 0; ok && i < 3; ++i) ok = c.at(i).get_double().get(xyz[i]) == simdjson::SUCCESS;
+    cityjson::add_vertex(out, xyz, ok, t, bad);
+  }
+}
+
+void note_bad_vertices(std::size_t bad, const std::string& where, const std::string& file, std::vector<Problem>& problems) {
+  if (bad)
+    problems.push_back(Problem{"", file, "read", "NOT_FINITE",
+                               where + ": " + std::to_string(bad) +
+                                   " vertices are not three numbers in double range; surfaces using them are dropped"});
+}
+
+/// The text of an object value (throws simdjson_error when it is not an object).
+std::string_view object_text(ondemand::value v) {
+  ondemand::object o = v.get_object();
+  return o.raw_json();
+}
+
+}  // namespace
+
+bool looks_like_cityjson(std::string_view head, bool* sequence) {
+  const auto first = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+  if (first == std::string_view::npos || head[first] != '{') return false;
+  // "type": "CityJSON" in the first document (the first line of a sequence).
+  const auto line_end = head.find('\n', first);
+  const std::string_view doc = head.substr(first, line_end == std::string_view::npos ? std::string_view::npos : line_end - first);
+  std::size_t at = 0;
+  bool found = false;
+  while (!found && (at = doc.find("\"type\"", at)) != std::string_view::npos) {
+    at += 6;
+    const auto v = doc.find_first_not_of(" \t\r\n:", at);
+    found = v != std::string_view::npos && doc.substr(v, 10) == "\"CityJSON\"";
+  }
+  if (!found && line_end == std::string_view::npos && head.find("\"CityJSON\"") == std::string_view::npos) return false;
+  if (!found) {
+    // A pretty-printed file: "type" may sit on a later line.
+    const auto t = head.find("\"type\"");
+    const auto v = t == std::string_view::npos ? t : head.find_first_not_of(" \t\r\n:", t + 6);
+    found = v != std::string_view::npos && head.substr(v, 10) == "\"CityJSON\"";
+  }
+  if (found && sequence) *sequence = line_end != std::string_view::npos && head.find("\"CityJSONFeature\"", line_end) != std::string_view::npos;
+  return found;
+}
+
+void read_cityjson(const std::string& path, const CityJsonOptions& options, const MeshCallback& on_mesh,
+                   std::vector<Problem>& problems, CityJsonInfo& info) {
+  info = CityJsonInfo{};
+  // The whole file, padded as simdjson needs (GDAL VSI: plain files, /vsigzip/, /vsizip/, /vsimem/).
+  // One allocation of the stated size (+ padding) when the size is known: on this kind of machine
+  // page faults and copies of a growing buffer cost more than the parse (tests/bench/RESULTS.md).
+  std::unique_ptr<char[]> bytes;
+  std::size_t capacity = 0, length = 0;
+  {
+    VsiFile holder;
+    VSILFILE* f = open_or_throw(path, holder);
+    VSIStatBufL st;
+    std::size_t stated = 0;
+    if (VSIStatL(path.c_str(), &st) == 0 && st.st_size > 0 && static_cast<std::uint64_t>(st.st_size) <= simdjson::SIMDJSON_MAXSIZE_BYTES)
+      stated = static_cast<std::size_t>(st.st_size);
+    auto grow = [&](std::size_t want) {
+      std::unique_ptr<char[]> next(new char[want]);
+      if (length) std::memcpy(next.get(), bytes.get(), length);
+      bytes = std::move(next);
+      capacity = want;
+    };
+    grow(stated + simdjson::SIMDJSON_PADDING + 1);  // + 1: the read after the last byte finds the end without growing
+    for (;;) {
+      if (length > simdjson::SIMDJSON_MAXSIZE_BYTES)
+        throw InputError(path + ": larger than 4 GiB, the most a CityJSON file can be read as one document; convert it "
+                                "to CityJSONSeq (cjseq cat, or cjio export jsonl) and read the .city.jsonl");
+      if (capacity - length <= simdjson::SIMDJSON_PADDING) grow(std::max<std::size_t>(2 * capacity, 1 << 20));
+      const std::size_t got = VSIFReadL(bytes.get() + length, 1, capacity - length - simdjson::SIMDJSON_PADDING, f);
+      length += got;
+      if (got == 0) break;
+    }
+  }
+  info.bytes = length;
+  std::memset(bytes.get() + length, 0, simdjson::SIMDJSON_PADDING);
+  const simdjson::padded_string_view json(bytes.get(), length, capacity);
+
+  Transform transform;
+  std::unique_ptr<dom::parser> meta_parser = make_dom_parser(options.max_depth);
+  std::unique_ptr<dom::parser> template_parser = make_dom_parser(options.max_depth);
+  Templates templates;
+  std::vector<Point3> vertices;
+  std::vector<double> raw;  // vertices as written until "transform" is known (it may come after them)
+  std::size_t bad_vertices = 0;
+  ObjectConverter converter(path, options, on_mesh, problems, info);
+  std::uint64_t at_object = 0;  // for messages: the city object being read
+  try {
+    ondemand::parser parser;
+    ondemand::document doc = parser.iterate(json);
+    ondemand::object root = doc.get_object();
+    bool is_cityjson = false;
+    bool has_objects = false;
+    for (auto field : root) {
+      const std::string_view key = field.unescaped_key();
+      if (key == "type") {
+        const std::string_view type = field.value().get_string();
+        if (type != "CityJSON")
+          throw InputError(path + ": \"type\" is \"" + std::string(type.substr(0, 40)) +
+                           "\", not \"CityJSON\" (a CityJSONFeature line belongs in a .city.jsonl sequence)");
+        is_cityjson = true;
+      } else if (key == "version") {
+        info.version = std::string(std::string_view(field.value().get_string()).substr(0, 16));
+      } else if (key == "transform") {
+        const std::string_view text = object_text(field.value());
+        transform = cityjson::parse_transform(meta_parser->parse(text.data(), text.size(), false), path);
+      } else if (key == "metadata") {
+        const std::string_view text = object_text(field.value());
+        read_metadata(meta_parser->parse(text.data(), text.size(), false), info);
+      } else if (key == "geometry-templates") {
+        const std::string_view text = object_text(field.value());
+        templates = cityjson::parse_templates(template_parser->parse(text.data(), text.size(), false), path, problems);
+      } else if (key == "vertices") {
+        for (auto v : field.value().get_array()) {
+          double xyz[3] = {NAN, NAN, NAN};
+          std::size_t n = 0;
+          bool ok = true;
+          ondemand::array coords;
+          if (v.get_array().get(coords) != simdjson::SUCCESS) {
+            ok = false;
+          } else {
+            for (auto c : coords) {
+              double d = NAN;
+              if (n < 3 && c.get_double().get(d) == simdjson::SUCCESS) xyz[n] = d;
+              else ok = false;
+              ++n;
+            }
+          }
+          ok = ok && n == 3;
+          raw.insert(raw.end(), {ok ? xyz[0] : NAN, xyz[1], xyz[2]});
+        }
+      } else if (key == "CityObjects") {
+        has_objects = true;  // second pass
+      }
+    }
+    if (!is_cityjson) throw InputError(path + ": no \"type\": \"CityJSON\" at the top level; not a CityJSON file");
+    if (!has_objects) throw InputError(path + ": no \"CityObjects\"; not a CityJSON file");
+    vertices.reserve(raw.size() / 3);
+    for (std::size_t i = 0; i + 2 < raw.size(); i += 3)
+      cityjson::add_vertex(vertices, &raw[i], std::isfinite(raw[i]) && std::isfinite(raw[i + 1]) && std::isfinite(raw[i + 2]),
+                           transform, bad_vertices);
+    std::vector<double>().swap(raw);
+    info.vertices = vertices.size();
+    note_bad_vertices(bad_vertices, "\"vertices\"", path, problems);
+
+    // A second iteration rather than doc.rewind(): UBSan finds rewind() reading a null parser after some
+    // malformed first passes (simdjson 3.0.1); the same parser keeps its buffers, only stage 1 runs again.
+    doc = parser.iterate(json);
+    std::unique_ptr<dom::parser> object_parser = make_dom_parser(options.max_depth);
+    for (auto field : doc.get_object()) {
+      const std::string_view key = field.unescaped_key();
+      if (key != "CityObjects") continue;
+      for (auto object : field.value().get_object()) {
+        ++at_object;
+        const std::string_view id = object.unescaped_key();
+        const std::string_view text = object_text(object.value());
+        dom::element element;
+        if (const auto err = object_parser->parse(text.data(), text.size(), false).get(element)) {
+          problems.push_back(Problem{std::string(id.substr(0, 256)), path, "read", "BAD_CITYOBJECT",
+                                     std::string("city object is not valid JSON: ") + simdjson::error_message(err)});
+          continue;
+        }
+        converter.convert(id, element, vertices, templates);
+      }
+    }
+  } catch (const simdjson::simdjson_error& e) {
+    std::string where = at_object ? " (at city object " + std::to_string(at_object) + ")" : "";
+    throw InputError(path + ": not valid CityJSON" + where + ": " + e.what());
+  }
+}
+
+void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, const MeshCallback& on_mesh,
+                       std::vector<Problem>& problems, CityJsonInfo& info) {
+  info = CityJsonInfo{};
+  info.sequence = true;
+  VsiFile holder;
+  VSILFILE* f = open_or_throw(path, holder);
+
+  Transform transform;
+  std::unique_ptr<dom::parser> header_parser = make_dom_parser(options.max_depth);  // keeps the templates alive
+  std::unique_ptr<dom::parser> line_parser = make_dom_parser(options.max_depth);
+  Templates templates;
+  std::vector<Point3> vertices;
+  ObjectConverter converter(path, options, on_mesh, problems, info);
+  bool have_header = false;
+
+  // Line by line through one buffer: constant memory (the longest line, at most max_line_bytes).
+  std::string buf;
+  std::size_t start = 0;      // first byte of the current line in buf
+  std::size_t line_no = 0;
+  bool skipping = false;      // inside a line that is too long: drop bytes up to its newline
+  bool eof = false;
+  constexpr std::size_t kChunk = 1 << 20;
+
+  auto handle_line = [&](std::string_view line) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string_view::npos) return;
+    const std::string name = path + " line " + std::to_string(line_no);
+    dom::element doc;
+    // buf keeps simdjson::SIMDJSON_PADDING bytes after every line (see below), so no copy is needed.
+    if (const auto err = line_parser->parse(line.data(), line.size(), false).get(doc)) {
+      if (!have_header) throw InputError(name + ": not valid JSON (" + simdjson::error_message(err) + ")");
+      problems.push_back(Problem{"", path, "read", "BAD_LINE",
+                                 "line " + std::to_string(line_no) + " is not valid JSON (" + simdjson::error_message(err) +
+                                     "); its features are skipped"});
+      return;
+    }
+    std::string_view type;
+    if (doc["type"].get_string().get(type) != simdjson::SUCCESS) type = {};
+    if (!have_header) {
+      if (type != "CityJSON")
+        throw InputError(name + ": the first line of a CityJSONSeq file must be the \"CityJSON\" header (transform, "
+                                "CRS), not \"" + std::string(type.substr(0, 40)) + "\"");
+      // The header is parsed again by its own parser, which lives as long as the templates.
+      dom::element header = header_parser->parse(line.data(), line.size(), false);
+      std::string_view version;
+      if (header["version"].get_string().get(version) == simdjson::SUCCESS) info.version = std::string(version.substr(0, 16));
+      dom::element e;
+      if (header["transform"].get(e) == simdjson::SUCCESS) transform = cityjson::parse_transform(e, path);
+      if (header["metadata"].get(e) == simdjson::SUCCESS) read_metadata(e, info);
+      if (header["geometry-templates"].get(e) == simdjson::SUCCESS)
+        templates = cityjson::parse_templates(e, path, problems);
+      have_header = true;
+      return;
+    }
+    if (type != "CityJSONFeature") {
+      problems.push_back(Problem{"", path, "read", "BAD_LINE",
+                                 "line " + std::to_string(line_no) + " is not a CityJSONFeature (\"type\": \"" +
+                                     std::string(type.substr(0, 40)) + "\"); skipped"});
+      return;
+    }
+    ++info.features;
+    dom::array verts;
+    dom::object objects;
+    if (doc["vertices"].get_array().get(verts) != simdjson::SUCCESS ||
+        doc["CityObjects"].get_object().get(objects) != simdjson::SUCCESS) {
+      std::string_view fid;
+      if (doc["id"].get_string().get(fid) != simdjson::SUCCESS) fid = {};
+      problems.push_back(Problem{std::string(fid.substr(0, 256)), path, "read", "BAD_LINE",
+                                 "line " + std::to_string(line_no) +
+                                     ": a CityJSONFeature needs \"CityObjects\" and \"vertices\"; skipped"});
+      return;
+    }
+    std::size_t bad = 0;
+    read_vertices(verts, transform, vertices, bad);
+    info.vertices += vertices.size();
+    note_bad_vertices(bad, "line " + std::to_string(line_no) + " \"vertices\"", path, problems);
+    for (auto [id, object] : objects) converter.convert(id, object, vertices, templates);
+  };
+
+  auto too_long = [&] {
+    ++line_no;
+    if (!have_header) throw InputError(path + ": the first line is longer than " + std::to_string(options.max_line_bytes) + " bytes");
+    problems.push_back(Problem{"", path, "read", "LINE_TOO_LONG",
+                               "line " + std::to_string(line_no) + " is longer than " +
+                                   std::to_string(options.max_line_bytes) + " bytes (max_line_bytes); skipped"});
+  };
+
+  while (!eof) {
+    // Keep the unfinished line at the front, then read the next chunk behind it.
+    if (start > 0) {
+      buf.erase(0, start);
+      start = 0;
+    }
+    const std::size_t at = buf.size();
+    buf.resize(at + kChunk);
+    const std::size_t got = VSIFReadL(buf.data() + at, 1, kChunk, f);
+    buf.resize(at + got);
+    info.bytes += got;
+    eof = got < kChunk;
+    std::size_t scan = at;
+    for (;;) {
+      const std::size_t nl = buf.find('\n', scan);
+      if (nl == std::string::npos) break;
+      if (skipping) {
+        skipping = false;
+      } else {
+        // Parse [start, nl) in place when the simdjson::SIMDJSON_PADDING bytes simdjson may read past its end
+        // lie inside buf; near the end of buf, a padded copy.
+        const std::size_t len = nl - start;
+        const std::string_view line(buf.data() + start, len);
+        std::string tail;
+        if (len > options.max_line_bytes) {
+          too_long();
+        } else if (buf.size() - nl < simdjson::SIMDJSON_PADDING) {
+          tail.assign(line);
+          tail.resize(len + simdjson::SIMDJSON_PADDING, '\0');
+          handle_line(std::string_view(tail.data(), len));
+        } else {
+          handle_line(line);
+        }
+      }
+      start = nl + 1;
+      scan = start;
+    }
+    if (buf.size() - start > options.max_line_bytes) {
+      if (!skipping) too_long();
+      skipping = true;
+      start = buf.size();
+    }
+  }
+  if (!skipping && start < buf.size() && buf.size() - start > options.max_line_bytes) {
+    too_long();
+  } else if (!skipping && start < buf.size()) {
+    std::string last = buf.substr(start);
+    const std::size_t len = last.size();
+    last.resize(len + simdjson::SIMDJSON_PADDING, '\0');
+    handle_line(std::string_view(last.data(), len));
+  }
+  if (!have_header) throw InputError(path + ": empty; a CityJSONSeq file starts with a \"CityJSON\" header line");
+}
+
+}  // namespace groundplan::gis
