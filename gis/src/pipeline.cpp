@@ -48,7 +48,7 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
       if (found.empty())
         throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb)");
       files.insert(files.end(), found.begin(), found.end());
-    } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0) {
+    } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0 || looks_like_connection_string(in)) {
       files.push_back(in);
     } else {
       throw InputError(in + ": no such file or folder");
@@ -131,6 +131,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
   ReadOptions read_options;
   read_options.lod = options.lod;
   read_options.origin = options.origin;
+  read_options.ogr = options.ogr_input;
   FootprintParams footprint_params;
   footprint_params.source = to_core(options.footprints);
 
@@ -192,8 +193,9 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
         if (!info.in_working_crs && !frame) {
           CrsOptions crs;
           crs.target_srs = working_definition;
-          crs.source_axis = options.source_axis;
-          frame = std::make_unique<WorkingFrame>(info.citygml.srs_name, crs, file);
+          // --axis-order wins; else the order the format fixes (OGR: GDAL's data axis order), else the CRS's rule.
+          crs.source_axis = options.source_axis != AxisOrder::Auto ? options.source_axis : info.source_axis;
+          frame = std::make_unique<WorkingFrame>(info.source_srs, crs, file);
         }
         const bool georeferenced = info.in_working_crs || (frame && frame->source_known());
         if (georeferenced && !unknown_frame_file.empty())

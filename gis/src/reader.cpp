@@ -61,6 +61,7 @@ const char* to_string(InputFormat f) {
     case InputFormat::Collada: return "COLLADA";
     case InputFormat::Gltf: return "glTF";
     case InputFormat::Glb: return "GLB";
+    case InputFormat::Ogr: return "OGR";
   }
   return "?";
 }
@@ -98,19 +99,32 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
   info = ReadInfo{};
   info.file = path;
   info.format = detect_format(path);
+  if (info.format == InputFormat::Unknown && ogr_can_read(path)) info.format = InputFormat::Ogr;
   if (info.format == InputFormat::Unknown) {
     VSIStatBufL st;
-    if (VSIStatL(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+    if (VSIStatL(path.c_str(), &st) != 0 && !looks_like_connection_string(path))
+      throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
     throw InputError(path + ": format not recognised (CityGML .gml/.citygml/.xml, KML .kml/.kmz, glTF .gltf/.glb, "
-                            "COLLADA .dae are read)");
+                            "COLLADA .dae, and any vector format GDAL reads: none of them knows it)");
   }
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
     opt.lod = options.lod;
     read_citygml(path, opt, [&](Mesh&& m) {
       ++info.meshes;
+      if (info.source_srs != info.citygml.srs_name) info.source_srs = info.citygml.srs_name;
       on_mesh(std::move(m));
     }, problems, info.citygml);
+    return;
+  }
+  if (info.format == InputFormat::Ogr) {
+    read_ogr(path, options.ogr, [&] {
+      info.source_srs = info.ogr.source_srs;
+      info.source_axis = info.ogr.east_north ? AxisOrder::EastNorth : AxisOrder::NorthEast;
+    }, [&](Mesh&& m) {
+      ++info.meshes;
+      on_mesh(std::move(m));
+    }, problems, info.ogr);
     return;
   }
 

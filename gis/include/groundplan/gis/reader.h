@@ -7,12 +7,15 @@
 //   .kml .kmz              KML + COLLADA  meshes in the working CRS (placed with GeographicLib + PROJ)
 //   .gltf .glb             glTF           meshes in the working CRS (ECEF georeference, else origin)
 //   .dae                   COLLADA alone  meshes in the working CRS; needs ReadOptions::origin
+//   anything else GDAL     OGR layers     meshes as written in the file's one source CRS (info.source_srs,
+//   reads as vector data                  GDAL's data axis order in info.source_axis); issue 22, ogr_input.h
 // The working CRS of self-georeferenced formats is ReadOptions::target_srs when given, else the
 // WGS 84 UTM zone of the first model's anchor; it is in info.working_crs once a mesh was placed.
 #include <groundplan/gis/citygml.h>
 #include <groundplan/gis/crs.h>
 #include <groundplan/gis/gltf.h>
 #include <groundplan/gis/kml.h>
+#include <groundplan/gis/ogr_input.h>
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
@@ -22,7 +25,7 @@
 
 namespace groundplan::gis {
 
-enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb };
+enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb, Ogr };
 const char* to_string(InputFormat format);
 
 struct ReadOptions {
@@ -31,6 +34,7 @@ struct ReadOptions {
   std::string origin;           // "lon,lat[,alt]" for glTF without georeference and bare .dae; empty = none
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
+  OgrInputOptions ogr;          // any OGR vector source: layers, filter, ids, grouping (issue 22)
 };
 
 struct ReadInfo {
@@ -39,9 +43,14 @@ struct ReadInfo {
   bool in_working_crs = false;  // meshes arrive in working_crs (KML, glTF, COLLADA); false: as written (CityGML)
   WorkingCrs working_crs;       // valid when in_working_crs and something was placed
   std::vector<std::string> notes;  // georeference notes (UTM zone chosen ...)
+  // When !in_working_crs: the CRS the meshes are written in (CityGML srsName, an OGR layer's EPSG:n or
+  // WKT; empty = none) and, where the format fixes it, their axis order (Auto: the CRS's rule).
+  std::string source_srs;
+  AxisOrder source_axis = AxisOrder::Auto;
   SourceInfo citygml;           // CityGML only
   KmlInfo kml;                  // KML/KMZ only
   GltfInfo gltf;                // glTF only
+  OgrInfo ogr;                  // OGR sources only
   std::size_t meshes = 0;       // meshes delivered
 };
 
@@ -54,7 +63,8 @@ InputFormat detect_format(const std::string& name, std::string_view head);
 /// not .dae: a .dae beside a .kml is the KML's model, not a second input).
 bool is_input_name(const std::string& name);
 
-/// Reads one file of any supported format. `info.format` and `info.in_working_crs` are set before
+/// Reads one file of any supported format (a file the city formats do not recognise goes to GDAL's
+/// vector drivers: identified by content, so connection strings and /vsi paths work too). `info.format` and `info.in_working_crs` are set before
 /// the first mesh is delivered. Per-building defects are Problems. Throws InputError naming the file
 /// when it cannot be read at all, when its format is unknown, or when a glTF / COLLADA file has no
 /// georeference and no origin was given ("pass --origin lon,lat,alt"); InvalidArgument for a bad
