@@ -6,10 +6,12 @@ shapefile and a PolyhedralSurface GeoPackage must give the plans of the CityGML 
 a generated OSM file must give GEOS's union; hostile inputs give named problems and lose no feature."""
 import json
 import math
+import pathlib
+import re
 import time
 
 import pytest
-from osgeo import ogr, osr
+from osgeo import gdal, ogr, osr
 
 from conftest import BIN, PLATEAU, SHARED_DATA, run
 
@@ -184,22 +186,40 @@ def _osm_xml():
             + "\n".join(nodes + ways + rels) + "\n</osm>\n")
 
 
+def _osm_config(tmp_path):
+    """GDAL's osmconf.ini with building:part among the tags that make a closed way a polygon (GDAL 3.6 lists
+    only building: its parts would land in the 'lines' layer) and as a field of 'multipolygons'."""
+    text = pathlib.Path(gdal.FindFile("gdal", "osmconf.ini")).read_text()
+    text = text.replace("closed_ways_are_polygons=aeroway,amenity,boundary,building,",
+                        "closed_ways_are_polygons=aeroway,amenity,boundary,building,building:part,", 1)
+    text = re.sub(r"(\[multipolygons\][^\[]*?attributes=name,)", r"\1building:part,", text, count=1)
+    assert "building,building:part," in text and "attributes=name,building:part," in text
+    path = tmp_path / "osmconf.ini"
+    path.write_text(text)
+    return path
+
+
 def test_osm_buildings_parts_and_courtyards_match_geos(tmp_path):
     src = tmp_path / "city.osm"
     src.write_text(_osm_xml())
+    conf = _osm_config(tmp_path)
     out = tmp_path / "o.gpkg"
-    run([BIN, "--input-layer", "multipolygons", "--group-by", "name", "--verify", "-f", "GPKG", out, src,
-         "ground_plans", "footprints", "problems"])
+    run([BIN, "--input-layer", "multipolygons", "--input-oo", f"CONFIG_FILE={conf}", "--group-by", "name",
+         "--verify", "-f", "GPKG", out, src, "ground_plans", "footprints", "problems"])
     out_ds = ogr.Open(str(out))
     plans_ = [f for f in out_ds.GetLayerByName("ground_plans")]
     by_ids = {f["building_ids"]: f for f in plans_}
     # hall: one building of three parts; court: one with a courtyard hole; house + garage touch: one plan.
     assert set(by_ids) == {"hall", "court", "house,garage"}
-    court = by_ids["court"]
-    assert court.GetGeometryRef().GetGeometryCount() == 2  # outer + courtyard
-    assert len(layer_items(out, "footprints")) == 4  # hall, court, house, garage
+    assert by_ids["court"].GetGeometryRef().GetGeometryCount() == 2  # outer + courtyard
+    assert len(layer_items(out, "footprints")) == 4  # hall (3 parts), court, house, garage
+    assert [p for p in layer_items(out, "problems") if p["code"] != "NOTE"] == []
+    # Without --group-by each part is a building of its own, and the plan still unites them.
+    out2 = tmp_path / "o2.gpkg"
+    run([BIN, "--input-layer", "multipolygons", "--input-oo", f"CONFIG_FILE={conf}", "-f", "GPKG", out2, src])
+    assert sorted(f["n_parts"] for f in layer_items(out2, "ground_plans")) == [1, 2, 3]
     # GEOS's union of GDAL's own polygons, transformed like ours, is the reference.
-    ds = ogr.Open(str(src))
+    ds = gdal.OpenEx(str(src), gdal.OF_VECTOR, open_options=[f"CONFIG_FILE={conf}"])
     lyr = ds.GetLayerByName("multipolygons")
     dst = out_ds.GetLayerByName("ground_plans").GetSpatialRef().Clone()
     src_srs = lyr.GetSpatialRef().Clone()
@@ -207,11 +227,14 @@ def test_osm_buildings_parts_and_courtyards_match_geos(tmp_path):
     dst.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
     ct = osr.CoordinateTransformation(src_srs, dst)
     coll = ogr.Geometry(ogr.wkbMultiPolygon)
+    n = 0
     for f in lyr:
+        n += 1
         g = f.GetGeometryRef().Clone()
         g.Transform(ct)
         for i in range(g.GetGeometryCount()):
             coll.AddGeometry(g.GetGeometryRef(i))
+    assert n == 6
     union = coll.UnionCascaded()
     ours = ogr.Geometry(ogr.wkbMultiPolygon)
     for f in plans_:
