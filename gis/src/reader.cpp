@@ -76,6 +76,8 @@ InputFormat detect_format(const std::string& name, std::string_view head) {
   if (ext == ".glb") return InputFormat::Glb;
   const InputFormat by_content = sniff(head);
   if (ext == ".xml" && by_content == InputFormat::Unknown) return InputFormat::CityGml;  // NOT_CITYGML if not
+  // A zip named .zip / .shz is no KMZ: GDAL reads zipped shapefiles (parts.shp.zip) and the like (issue 22).
+  if (by_content == InputFormat::Kmz && (ext == ".zip" || ext == ".shz")) return InputFormat::Unknown;
   return by_content;
 }
 

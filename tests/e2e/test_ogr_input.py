@@ -79,6 +79,19 @@ def test_2d_footprints_written_by_gdal_give_the_citygml_plans(tmp_path, city_foo
     assert stats["counts"]["buildings"] == n_features
 
 
+def test_a_zipped_shapefile_is_read_by_gdal_not_taken_for_a_kmz(tmp_path, city_footprints):
+    import zipfile
+    city = city_footprints["niiza"]
+    run(["ogr2ogr", "-f", "ESRI Shapefile", tmp_path / "fp.shp", city, "footprints"])
+    src = tmp_path / "fp.shp.zip"
+    with zipfile.ZipFile(src, "w") as z:
+        for ext in (".shp", ".shx", ".dbf", ".prj"):
+            z.write(tmp_path / f"fp{ext}", f"fp{ext}")
+    out = tmp_path / "o.gpkg"
+    run([BIN, "--id-field", "source_id", "-f", "GPKG", out, src])
+    assert plans(out) == plans(city)
+
+
 def test_the_driver_reads_ogr_sources_with_open_options(tmp_path, city_footprints):
     """GROUNDPLAN:<shapefile> through GDAL's own ogr2ogr, with INPUT_WHERE and ID_FIELD."""
     city = city_footprints["niiza"]

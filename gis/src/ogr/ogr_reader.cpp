@@ -328,7 +328,7 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
       }
     }
   }
-  errors.take();
+  if (const std::string said = errors.take(); !said.empty()) problems.push_back({"", path, "read", "NOTE", said});
   if (source_srs_ready) source_srs_ready();
 
   const bool prefix_layer = plans.size() > 1;
@@ -383,6 +383,8 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
     if (f.vertices > options.max_vertices)
       return bad("TOO_MANY_VERTICES", std::to_string(f.vertices) + " vertices, more than the limit of " +
                                           std::to_string(options.max_vertices));
+    if (!gdal.empty())  // GDAL said something about a feature it still gave: kept, and said
+      problems.push_back({building, path, "read", "NOTE", where + gdal});
     if (f.non_areal)
       problems.push_back({building, path, "read", "NON_AREAL_PARTS",
                           where + std::to_string(f.non_areal) + " point or line parts of the geometry are left out "
@@ -410,7 +412,8 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
   auto layer_stopped = [&](const LayerPlan& p) {
     // A GDAL failure that ended the layer (a cut-short file ...): say so; features after it are not read.
     if (!errors.failure()) {
-      errors.take();
+      const std::string warnings = errors.take();
+      if (!warnings.empty()) problems.push_back({"", path, "read", "NOTE", "layer '" + p.name + "': " + warnings});
       return;
     }
     problems.push_back({"", path, "read", "UNREADABLE_FEATURES",

@@ -183,6 +183,14 @@ TEST(OgrReader, ReadAnyDispatchesByContentAndThePipelinePlacesTheLayer) {
   VSIUnlink(path.c_str());
 }
 
+TEST(OgrReader, AZippedShapefileIsNoKmz) {
+  const std::string zip_head("PK\x03\x04\x14\x00", 6);
+  EXPECT_EQ(detect_format("parts.shp.zip", zip_head), InputFormat::Unknown);  // left to GDAL
+  EXPECT_EQ(detect_format("parts.shz", zip_head), InputFormat::Unknown);
+  EXPECT_EQ(detect_format("model", zip_head), InputFormat::Kmz);              // a KMZ without its extension
+  EXPECT_EQ(detect_format("model.kmz", zip_head), InputFormat::Kmz);
+}
+
 TEST(OgrReader, ConnectionStringsAreToldFromFileNames) {
   EXPECT_TRUE(looks_like_connection_string("PG:dbname=city"));
   EXPECT_TRUE(looks_like_connection_string("WFS:https://example.org/wfs"));
