@@ -99,40 +99,51 @@ bool data_east_north(const OGRSpatialReference& srs) {
   return orient != OAO_North && orient != OAO_South;
 }
 
-/// One feature's geometry taken apart into faces (rings without the closing vertex).
+/// One feature's geometry as mesh faces (rings without the closing vertex), written straight into the
+/// mesh's flat arrays: a million footprints are a million small meshes, so no per-ring vectors.
 struct Faces {
-  std::vector<std::vector<std::vector<Point3>>> faces;  // face -> rings (outer first) -> points
-  std::size_t non_areal = 0;                           // points / lines met
-  std::size_t vertices = 0;
+  Mesh mesh;                  // faces of kind FootPrint until classify() says otherwise
+  std::size_t non_areal = 0;  // points / lines met
   bool non_finite = false;
   double max_abs = 0;
 };
 
-void add_ring(const OGRLinearRing* ring, std::vector<std::vector<Point3>>& rings, Faces& out) {
-  std::vector<Point3>& pts = rings.emplace_back();
+void add_ring(const OGRLinearRing* ring, Faces& out) {
+  Mesh& m = out.mesh;
   const int n = ring ? ring->getNumPoints() : 0;
-  pts.reserve(static_cast<std::size_t>(std::max(n, 0)));
-  for (int i = 0; i < n; ++i) {
+  int last = n;
+  if (n > 1 && ring->getX(0) == ring->getX(n - 1) && ring->getY(0) == ring->getY(n - 1) &&
+      ring->getZ(0) == ring->getZ(n - 1))
+    last = n - 1;  // the closing vertex
+  m.vertices.reserve(m.vertices.size() + static_cast<std::size_t>(std::max(last, 0)));
+  for (int i = 0; i < last; ++i) {
     const Point3 p{ring->getX(i), ring->getY(i), ring->getZ(i)};
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) out.non_finite = true;
     out.max_abs = std::max({out.max_abs, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    pts.push_back(p);
+    m.indices.push_back(static_cast<std::uint32_t>(m.vertices.size()));
+    m.vertices.push_back(p);
   }
-  if (pts.size() > 1 && pts.front() == pts.back()) pts.pop_back();
-  out.vertices += pts.size();
+  m.ring_offsets.push_back(static_cast<std::uint32_t>(m.indices.size()));
+}
+
+void add_polygon(const OGRPolygon* poly, Faces& out) {
+  MeshFace f;
+  f.first_ring = static_cast<std::uint32_t>(out.mesh.ring_count());
+  f.ring_count = static_cast<std::uint32_t>(1 + poly->getNumInteriorRings());
+  f.kind = SurfaceKind::FootPrint;
+  f.lod = 0;
+  add_ring(poly->getExteriorRing(), out);
+  for (int i = 0; i < poly->getNumInteriorRings(); ++i) add_ring(poly->getInteriorRing(i), out);
+  out.mesh.faces.push_back(f);
 }
 
 void collect(const OGRGeometry* g, Faces& out, int depth) {
   if (!g || g->IsEmpty() || depth > 32) return;
   switch (wkbFlatten(g->getGeometryType())) {
     case wkbPolygon:
-    case wkbTriangle: {
-      const auto* poly = g->toPolygon();
-      auto& rings = out.faces.emplace_back();
-      add_ring(poly->getExteriorRing(), rings, out);
-      for (int i = 0; i < poly->getNumInteriorRings(); ++i) add_ring(poly->getInteriorRing(i), rings, out);
+    case wkbTriangle:
+      add_polygon(g->toPolygon(), out);
       break;
-    }
     case wkbPolyhedralSurface:
     case wkbTIN: {
       const auto* ps = g->toPolyhedralSurface();
@@ -152,14 +163,15 @@ void collect(const OGRGeometry* g, Faces& out, int depth) {
   }
 }
 
-/// True when face `rings[0]` is horizontal within the footprint's tolerance (Newell's normal), or has no area.
-bool horizontal(const std::vector<Point3>& ring) {
-  if (ring.size() < 3) return true;
-  const Point3 o = ring[0];
+/// True when ring r is horizontal within the footprint's tolerance (Newell's normal), or has no area.
+bool horizontal(const Mesh& m, std::uint32_t r) {
+  const std::uint32_t a = m.ring_offsets[r], b = m.ring_offsets[r + 1];
+  if (b - a < 3) return true;
+  const Point3 o = m.vertices[m.indices[a]];
   double nx = 0, ny = 0, nz = 0;
-  for (std::size_t k = 0; k < ring.size(); ++k) {
-    const Point3& p = ring[k];
-    const Point3& q = ring[(k + 1) % ring.size()];
+  for (std::uint32_t k = a; k < b; ++k) {
+    const Point3& p = m.vertices[m.indices[k]];
+    const Point3& q = m.vertices[m.indices[k + 1 < b ? k + 1 : a]];
     const double px = p.x - o.x, py = p.y - o.y, pz = p.z - o.z, qx = q.x - o.x, qy = q.y - o.y, qz = q.z - o.z;
     nx += (py - qy) * (pz + qz);
     ny += (pz - qz) * (px + qx);
@@ -169,14 +181,32 @@ bool horizontal(const std::vector<Point3>& ring) {
   return len == 0 || std::fabs(nz) >= std::cos(kHorizontalToleranceDeg * kPi / 180.0) * len;
 }
 
-/// Appends the faces to `mesh`: FootPrint faces when all are horizontal (a footprint given outright),
-/// else Unknown (a solid or surface: its bottom, or decomposition).
-void append_faces(const Faces& f, bool is_3d, Mesh& mesh) {
-  bool flat = true;
-  if (is_3d)
-    for (const auto& face : f.faces) flat = flat && horizontal(face.front());
-  const SurfaceKind kind = flat ? SurfaceKind::FootPrint : SurfaceKind::Unknown;
-  for (const auto& face : f.faces) mesh.add_face(face, kind, flat ? 0 : 255);
+/// FootPrint faces when all are horizontal (a footprint given outright), else Unknown (a solid or
+/// surface: its bottom, or decomposition).
+void classify(Mesh& m, bool is_3d) {
+  if (!is_3d) return;
+  for (const MeshFace& f : m.faces)
+    if (!horizontal(m, f.first_ring)) {
+      for (MeshFace& g : m.faces) {
+        g.kind = SurfaceKind::Unknown;
+        g.lod = 255;
+      }
+      return;
+    }
+}
+
+/// Appends the faces of `from` to `to` (a --group-by building).
+void append_mesh(const Mesh& from, Mesh& to) {
+  const auto v0 = static_cast<std::uint32_t>(to.vertices.size());
+  const auto i0 = static_cast<std::uint32_t>(to.indices.size());
+  const auto r0 = static_cast<std::uint32_t>(to.ring_count());
+  to.vertices.insert(to.vertices.end(), from.vertices.begin(), from.vertices.end());
+  for (std::uint32_t i : from.indices) to.indices.push_back(v0 + i);
+  for (std::size_t r = 1; r < from.ring_offsets.size(); ++r) to.ring_offsets.push_back(i0 + from.ring_offsets[r]);
+  for (MeshFace f : from.faces) {
+    f.first_ring += r0;
+    to.faces.push_back(f);
+  }
 }
 
 struct LayerPlan {
@@ -345,12 +375,12 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
     if (id.empty()) id = prefix_layer ? p.name + ":" + fid_text : fid_text;
     std::optional<std::string> group;
     if (p.group_index >= 0 && feature.IsFieldSetAndNotNull(p.group_index)) group = feature.GetFieldAsString(p.group_index);
-    const std::string building = group ? *group : id;
-    const std::string where = "layer '" + p.name + "', FID " + fid_text + ": ";
+    auto building = [&] { return group ? *group : id; };  // before id moves into the mesh
+    auto where = [&] { return "layer '" + p.name + "', FID " + fid_text + ": "; };
     const std::string gdal = errors.take();
     auto bad = [&](const char* code, const std::string& what) {
       ++info.features_bad;
-      problems.push_back({building, path, "read", code, where + what + (gdal.empty() ? "" : " (" + gdal + ")")});
+      problems.push_back({building(), path, "read", code, where() + what + (gdal.empty() ? "" : " (" + gdal + ")")});
     };
 
     OGRGeometry* geom = feature.GetGeometryRef();
@@ -374,21 +404,22 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
     }
     Faces f;
     collect(geom, f, 0);
-    if (f.faces.empty())
+    if (f.mesh.faces.empty())
       return bad("NOT_AREAL", std::string("a ") + OGRGeometryTypeToName(geom->getGeometryType()) +
                                   " has no area: only polygons and surfaces are footprints");
     if (f.non_finite) return bad("BAD_COORDINATES", "a coordinate is NaN or infinite");
     if (f.max_abs > options.max_abs_coordinate)
       return bad("COORDINATE_OUT_OF_RANGE", "a coordinate's magnitude exceeds " + std::to_string(options.max_abs_coordinate));
-    if (f.vertices > options.max_vertices)
-      return bad("TOO_MANY_VERTICES", std::to_string(f.vertices) + " vertices, more than the limit of " +
+    if (f.mesh.vertices.size() > options.max_vertices)
+      return bad("TOO_MANY_VERTICES", std::to_string(f.mesh.vertices.size()) + " vertices, more than the limit of " +
                                           std::to_string(options.max_vertices));
     if (!gdal.empty())  // GDAL said something about a feature it still gave: kept, and said
-      problems.push_back({building, path, "read", "NOTE", where + gdal});
+      problems.push_back({building(), path, "read", "NOTE", where() + gdal});
     if (f.non_areal)
-      problems.push_back({building, path, "read", "NON_AREAL_PARTS",
-                          where + std::to_string(f.non_areal) + " point or line parts of the geometry are left out "
+      problems.push_back({building(), path, "read", "NON_AREAL_PARTS",
+                          where() + std::to_string(f.non_areal) + " point or line parts of the geometry are left out "
                                   "(no area); its polygons are used"});
+    classify(f.mesh, geom->Is3D());
     if (group) {
       auto [it, fresh] = group_of.try_emplace(*group, groups.size());
       if (fresh) {
@@ -397,14 +428,13 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
         m.source_file = path;
         m.name = p.name;
       }
-      append_faces(f, geom->Is3D(), groups[it->second]);
+      append_mesh(f.mesh, groups[it->second]);
       return;
     }
-    Mesh m;
-    m.source_id = id;
+    Mesh& m = f.mesh;
+    m.source_id = std::move(id);
     m.source_file = path;
     m.name = p.name;
-    append_faces(f, geom->Is3D(), m);
     ++info.buildings;
     on_mesh(std::move(m));
   };
