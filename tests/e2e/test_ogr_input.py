@@ -105,6 +105,15 @@ def test_the_driver_reads_ogr_sources_with_open_options(tmp_path, city_footprint
     assert ids == want and len(ids) == 100
 
 
+def test_our_own_driver_is_never_an_input(tmp_path, city_footprints):
+    """GROUNDPLAN:x as a source would run the pipeline inside the reader (plans of plans, or recursion):
+    GDAL's identify runs without our driver, so it is refused."""
+    src = tmp_path / "fp.gpkg"
+    run(["ogr2ogr", "-f", "GPKG", src, city_footprints["niiza"], "footprints"])
+    p = run([BIN, "-f", "GPKG", tmp_path / "x.gpkg", f"GROUNDPLAN:{src}"], check=False)
+    assert p.returncode == 1 and "format not recognised" in p.stderr and f"GROUNDPLAN:{src}" in p.stderr
+
+
 def test_input_sql_and_a_missing_layer_or_field(tmp_path, city_footprints):
     city = city_footprints["niiza"]
     src = tmp_path / "fp.gpkg"

@@ -23,6 +23,17 @@ constexpr const char* kOwnDriver = "GroundPlan";
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kHorizontalToleranceDeg = 10.0;  // as FootprintParams::horizontal_tolerance_deg
 
+/// GDAL's drivers, once per process (the CLI and the plugin have registered them already; a library
+/// caller may not have). GDALAllRegister is not safe to run on several threads at once: a static's
+/// initialisation is.
+void ensure_registered() {
+  static const bool registered = [] {
+    if (GDALGetDriverCount() == 0) GDALAllRegister();
+    return true;
+  }();
+  (void)registered;
+}
+
 /// Every vector driver but ours, for GDALOpenEx / GDALIdentifyDriverEx: GROUNDPLAN:x must never come
 /// back here (recursion), and a raster driver has no features.
 CPLStringList vector_drivers() {
@@ -265,7 +276,7 @@ bool looks_like_connection_string(const std::string& path) {
 
 bool ogr_can_read(const std::string& path) {
   try {
-    GDALAllRegister();
+    ensure_registered();
     const CPLStringList drivers = vector_drivers();
     CPLErrorStateBackuper keep_last_error;
     CPLPushErrorHandler(CPLQuietErrorHandler);
@@ -279,7 +290,7 @@ bool ogr_can_read(const std::string& path) {
 
 void read_ogr(const std::string& path, const OgrInputOptions& options, const std::function<void()>& source_srs_ready,
               const std::function<void(Mesh&&)>& on_mesh, std::vector<Problem>& problems, OgrInfo& info) {
-  GDALAllRegister();
+  ensure_registered();
   info = OgrInfo{};
   ErrorCollector errors;
   const CPLStringList drivers = vector_drivers();

@@ -17,6 +17,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace groundplan::gis {
@@ -181,6 +182,40 @@ TEST(OgrReader, ReadAnyDispatchesByContentAndThePipelinePlacesTheLayer) {
   EXPECT_FALSE(ogr_can_read(path));
   EXPECT_THROW(read_any(path, ReadOptions{}, [](Mesh&&) {}, problems, info), InputError);
   VSIUnlink(path.c_str());
+}
+
+TEST(OgrReader, TwoFilesReadAtOnceOnTwoThreadsGiveWhatEachGivesAlone) {
+  // The lead's parallel reading: one read_ogr per file and thread, each with its own dataset handle.
+  const std::string a = "/vsimem/ogr_reader_test/t1.geojson", b = "/vsimem/ogr_reader_test/t2.geojson";
+  put(a, kGeoJson);
+  std::string other = kGeoJson;  // the same features in EPSG:4326 would need another file; ids differ instead
+  other.replace(other.find("\"square\""), 8, "\"carre_\"");
+  put(b, other);
+  OgrInputOptions o;
+  o.id_field = "name";
+  const Read alone_a = read(a, o), alone_b = read(b, o);
+  for (int round = 0; round < 20; ++round) {
+    Read ra, rb;
+    std::thread ta([&] { ra = read(a, o); });
+    std::thread tb([&] { rb = read(b, o); });
+    ta.join();
+    tb.join();
+    ASSERT_EQ(ra.meshes.size(), alone_a.meshes.size());
+    ASSERT_EQ(rb.meshes.size(), alone_b.meshes.size());
+    for (std::size_t i = 0; i < ra.meshes.size(); ++i) {
+      EXPECT_EQ(ra.meshes[i].source_id, alone_a.meshes[i].source_id);
+      EXPECT_EQ(ra.meshes[i].vertices, alone_a.meshes[i].vertices);
+    }
+    for (std::size_t i = 0; i < rb.meshes.size(); ++i) {
+      EXPECT_EQ(rb.meshes[i].source_id, alone_b.meshes[i].source_id);
+      EXPECT_EQ(rb.meshes[i].vertices, alone_b.meshes[i].vertices);
+    }
+    EXPECT_EQ(codes(ra.problems), codes(alone_a.problems));
+    EXPECT_EQ(codes(rb.problems), codes(alone_b.problems));
+  }
+  EXPECT_EQ(alone_b.meshes[0].source_id, "carre_");
+  VSIUnlink(a.c_str());
+  VSIUnlink(b.c_str());
 }
 
 TEST(OgrReader, AZippedShapefileIsNoKmz) {
