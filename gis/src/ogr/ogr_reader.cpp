@@ -316,6 +316,9 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
     }
   } sql{ds.get(), nullptr};
   std::vector<LayerPlan> plans;
+  if (!options.sql.empty() && (!options.where.empty() || !options.layers.empty()))
+    throw InputError(path + ": --input-sql names its own layer and condition: --input-layer and --input-where "
+                          "do not apply to it (put them in the statement)");
   if (!options.sql.empty()) {
     sql.layer = ds->ExecuteSQL(options.sql.c_str(), nullptr, options.dialect.empty() ? nullptr : options.dialect.c_str());
     if (!sql.layer) {

@@ -249,6 +249,12 @@ TEST(OgrReader, MissingLayerOrFieldNamesTheSource) {
   o.layers.clear();
   o.id_field = "nope";
   EXPECT_THROW(read(path, o), InputError);
+  o.id_field.clear();
+  o.sql = "SELECT * FROM m";  // the GeoJSON layer is named after the file
+  o.where = "name = 'square'";  // would be ignored: refused instead
+  EXPECT_THROW(read(path, o), InputError);
+  o.where.clear();
+  EXPECT_EQ(read(path, o).meshes.size(), 4u);
   VSIUnlink(path.c_str());
 }
 
