@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <sys/resource.h>
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
@@ -231,8 +232,20 @@ std::string lod_summary(const groundplan::LodParams& p, const groundplan::LodSta
   return out;
 }
 
-bool write_stats(const std::string& path, const PipelineResult& result, double write_s, const nlohmann::json* verify,
-                 const groundplan::LodParams& lod) {
+using clock = std::chrono::steady_clock;
+
+double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
+
+/// CPU time of the process, all threads (getrusage): compared with the wall time it shows idle or spinning cores.
+double cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+bool write_stats(const std::string& path, const PipelineResult& result, double write_s, double total_s, double cpu_s,
+                 const nlohmann::json* verify, const groundplan::LodParams& lod) {
   nlohmann::json j;
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                  {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
@@ -240,7 +253,13 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
                  {"holes", count_holes(result)},          {"problems", count_defects(result)}};
   j["timings_s"] = {{"read", result.timings.read_s},     {"footprints", result.timings.footprints_s},
                     {"blocks", result.timings.blocks_s}, {"union", result.timings.union_s},
-                    {"level_of_detail", result.timings.lod_s}, {"write", write_s}};
+                    {"level_of_detail", result.timings.lod_s}, {"write", write_s},
+                    {"total", total_s},                  {"cpu", cpu_s}};
+  const groundplan::gis::ReadStats& rs = result.reading;
+  nlohmann::json whole = nlohmann::json::array();
+  for (const auto& [file, why] : rs.read_whole) whole.push_back({{"file", file}, {"why", why}});
+  j["reading"] = {{"threads", rs.threads}, {"files", rs.files},       {"bytes", rs.bytes},
+                  {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole}};
   j["raster_backend"] = result.raster_backend;
   if (lod.any()) j["level_of_detail"] = lod_json(lod, result.lod_stats);
   if (verify) j["verify"] = *verify;
@@ -291,6 +310,14 @@ int run(int argc, char** argv) {
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
   app.add_option("--preview", preview_path, "Write a PNG map of the plans (holes open, problem buildings in red)");
+  int threads = 0;
+  std::int64_t read_chunk_bytes = 0;
+  auto* o_threads = app.add_option("--threads", threads, "Threads for every stage (0 = all cores; default: GDAL's "
+                                                         "GDAL_NUM_THREADS config option, else all cores)")
+                        ->check(CLI::NonNegativeNumber);
+  app.add_option("--read-chunk-bytes", read_chunk_bytes,
+                 "CityGML files are cut into chunks of about this many bytes read side by side (0 = automatic, "
+                 "-1 = never); the result is the same either way");
   // Level of detail (issue 9, docs/level_of_detail.md): off by default, the exact union.
   std::string preset = "none", resolution_mode = "exact";
   groundplan::LodParams lod_flags;
@@ -356,14 +383,22 @@ int run(int argc, char** argv) {
   if (o_min_area->count()) options.detail.min_area_m2 = lod_flags.min_area_m2;
   if (o_simplify->count()) options.detail.simplify_m = lod_flags.simplify_m;
 
-  using clock = std::chrono::steady_clock;
+  // --threads, else GDAL's GDAL_NUM_THREADS (--config GDAL_NUM_THREADS 4, or the environment), else all cores.
+  if (o_threads->count())
+    options.threads = threads;
+  else if (const char* v = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))
+    options.threads = groundplan::gis::threads_from_string(v, "GDAL_NUM_THREADS");
+  options.read_chunk_bytes = read_chunk_bytes;
+
+  const double cpu0 = cpu_seconds();
   const auto t0 = clock::now();
   groundplan::Progress progress;
   if (ogr.progress && !ogr.quiet)
     progress = groundplan::Progress([](double f, const char* msg) {
       return GDALTermProgress(f, msg, nullptr) != FALSE;
     });
-  const PipelineResult result = groundplan::gis::run_pipeline(options, progress.sub(0, 1));
+  const auto result_ptr = std::make_shared<const PipelineResult>(groundplan::gis::run_pipeline(options, progress.sub(0, 1)));
+  const PipelineResult& result = *result_ptr;
 
   // Nothing usable (every building a problem, or no building at all): say so and fail, without
   // writing an empty result that would look like success (issue 8). The problems say why.
@@ -373,14 +408,15 @@ int run(int argc, char** argv) {
                  result.buildings_read == 0
                      ? "no building found"
                      : (std::to_string(result.buildings_read) + " buildings read, none gave a footprint").c_str());
-    if (!stats_path.empty()) write_stats(stats_path, result, 0, nullptr, options.detail);
+    if (!stats_path.empty())
+      write_stats(stats_path, result, 0, seconds_since(t0), cpu_seconds() - cpu0, nullptr, options.detail);
     return 1;
   }
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
   const bool dbf = writes_dbf(ogr);
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
-                                                             result, dbf ? 254 : 0);
+                                                             result_ptr, dbf ? 254 : 0, options.threads);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
   std::vector<std::string> vt_args = ogr.options;
   if (!ogr.layer_named) vt_args.push_back("ground_plans");
@@ -407,7 +443,8 @@ int run(int argc, char** argv) {
                    (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id)";
   }
   GDALClose(src_h);
-  const double write_s = std::chrono::duration<double>(clock::now() - t_write).count();
+  const double write_s = seconds_since(t_write);
+  const double total_s = seconds_since(t0), cpu_s = cpu_seconds() - cpu0;  // before --verify and --preview
   if (!write_ok) {
     std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr.dst.c_str(),
                  usage_error ? " (bad ogr2ogr options)" : "");
@@ -424,7 +461,7 @@ int run(int argc, char** argv) {
     std::printf(
         "groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, blocks %.2f s (%zu, %s), union %.2f s, "
         "write %.2f s)\n",
-        ogr.dst.c_str(), std::chrono::duration<double>(clock::now() - t0).count(), result.timings.read_s,
+        ogr.dst.c_str(), total_s, result.timings.read_s,
         result.timings.footprints_s, result.timings.blocks_s, result.blocks, result.raster_backend.c_str(),
         result.timings.union_s, write_s);
     if (options.detail.any())
@@ -459,7 +496,8 @@ int run(int argc, char** argv) {
                    {"holes_geos_artifacts", c.holes_geos_artifacts}};
     if (!ok) rc = 3;
   }
-  if (!stats_path.empty() && !write_stats(stats_path, result, write_s, verify ? &verify_json : nullptr, options.detail))
+  if (!stats_path.empty() && !write_stats(stats_path, result, write_s, total_s, cpu_s, verify ? &verify_json : nullptr,
+                                          options.detail))
     return 1;
   return rc;
 }

@@ -7,22 +7,32 @@
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
 
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
+#include <functional>
 #include <memory>
 #include <vector>
 
 namespace groundplan::driver {
 
-/// A layer over features built once; filters and counts behave as OGR users expect.
+/// A layer whose features are made from the pipeline's result when they are read, in batches built on
+/// all cores (the next batch while the writer takes the current one): nothing is built for a layer that
+/// is not read, and GetNextFeature hands features over without copying them. Filters and counts behave
+/// as OGR users expect.
 class OGRGroundPlanLayer final : public OGRLayer {
  public:
-  OGRGroundPlanLayer(const char* name, OGRwkbGeometryType geom_type, const OGRSpatialReference* srs);
+  /// Makes the feature of index i (FID i + 1) with `defn`; called from several threads at once.
+  using Maker = std::function<OGRFeature*(OGRFeatureDefn* defn, std::size_t i)>;
+  using Extent = std::function<OGREnvelope()>;
+  /// `threads`: cores that build batches (0 = all).
+  OGRGroundPlanLayer(const char* name, OGRwkbGeometryType geom_type, const OGRSpatialReference* srs,
+                     std::size_t count, Maker make, Extent extent = {}, int threads = 0);
   ~OGRGroundPlanLayer() override;
 
   OGRFeatureDefn* defn() { return defn_; }
-  /// Takes ownership; sets the FID to its position + 1.
-  void add(std::unique_ptr<OGRFeature> feature);
 
-  void ResetReading() override { next_ = 0; }
+  void ResetReading() override;
   OGRFeature* GetNextFeature() override;
   OGRFeature* GetFeature(GIntBig fid) override;
   GIntBig GetFeatureCount(int force) override;
@@ -32,11 +42,23 @@ class OGRGroundPlanLayer final : public OGRLayer {
   int TestCapability(const char* cap) override;
 
  private:
+  using Batch = std::vector<std::unique_ptr<OGRFeature>>;
   bool passes_filters(OGRFeature* f);
+  void build(Batch& batch, std::size_t first);  // features [first, first + kBatch) on all cores
+  void wait_prefetch();
+  void take_batch(std::size_t first);           // the batch that starts at `first`; then prefetches the next
+
   OGRFeatureDefn* defn_;
-  std::vector<std::unique_ptr<OGRFeature>> features_;
-  std::size_t next_ = 0;
+  std::size_t count_;
+  Maker make_;
+  Extent extent_fn_;
   OGREnvelope extent_;
+  bool extent_done_ = false;
+  Batch batch_, next_batch_;
+  std::size_t batch_first_ = 0, batch_pos_ = 0, next_first_ = 0;
+  bool prefetching_ = false;
+  tbb::task_arena arena_;
+  std::unique_ptr<tbb::task_group> prefetch_ = std::make_unique<tbb::task_group>();  // a member task_group would make the destructor throwing
 };
 
 class OGRGroundPlanDataSource final : public GDALDataset {
@@ -45,8 +67,9 @@ class OGRGroundPlanDataSource final : public GDALDataset {
   /// `max_id_list_chars` > 0 cuts building_ids to that many characters at a comma, ending in
   /// "...(+N)" so the cut is visible (DBF fields hold 254); the full lists are always in plan_members.
   /// It also names fields within DBF's 10 characters: building_ids -> bldg_ids, source_file -> src_file.
-  OGRGroundPlanDataSource(const std::string& description, const gis::PipelineResult& result,
-                          std::size_t max_id_list_chars = 0);
+  /// `threads`: cores that build the features (0 = all).
+  OGRGroundPlanDataSource(const std::string& description, std::shared_ptr<const gis::PipelineResult> result,
+                          std::size_t max_id_list_chars = 0, int threads = 0);
 
   /// Plans whose building_ids were cut (see max_id_list_chars).
   std::size_t id_lists_cut() const { return id_lists_cut_; }
@@ -61,6 +84,8 @@ class OGRGroundPlanDataSource final : public GDALDataset {
 
  private:
   std::vector<std::unique_ptr<OGRGroundPlanLayer>> layers_;
+  std::shared_ptr<const gis::PipelineResult> result_;
+  std::vector<GIntBig> plan_of_;  // the plan (gp_id) that holds each footprint; 0: none
   OGRSpatialReference srs_;
   std::size_t id_lists_cut_ = 0;
 };

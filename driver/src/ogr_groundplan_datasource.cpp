@@ -52,62 +52,115 @@ std::string cut_id_list(const std::string& ids, std::size_t count, std::size_t m
   return ids.substr(0, end) + (kept ? "," : "") + "...(+" + std::to_string(count - kept) + ")";
 }
 
+/// The envelope of `rings` (outer rings of plans or footprint polygons).
+template <class ForEachRing>
+OGREnvelope envelope_of(ForEachRing&& for_each_ring) {
+  OGREnvelope e;
+  for_each_ring([&](const Ring& r) {
+    for (const Point2& p : r) e.Merge(p.x, p.y);
+  });
+  return e;
+}
+
 }  // namespace
 
-OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description, const gis::PipelineResult& result,
-                                                 std::size_t max_id_list_chars) {
+OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
+                                                 std::shared_ptr<const gis::PipelineResult> result,
+                                                 std::size_t max_id_list_chars, int threads)
+    : result_(std::move(result)) {
   SetDescription(description.c_str());
+  const gis::PipelineResult& r = *result_;
   const OGRSpatialReference* srs = nullptr;
-  if (!result.crs_wkt.empty() && srs_.importFromWkt(result.crs_wkt.c_str()) == OGRERR_NONE) {
+  if (!r.crs_wkt.empty() && srs_.importFromWkt(r.crs_wkt.c_str()) == OGRERR_NONE) {
     srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     srs = &srs_;
   }
-  const auto& fps = result.footprints;
+  const gis::PipelineResult* res = result_.get();  // the layers' makers share it with this dataset
+  const auto& fps = r.footprints;
 
-  // Which plan holds each footprint (for the footprints layer's gp_id).
-  std::vector<GIntBig> plan_of(fps.size(), 0);
+  // Which plan holds each footprint (for the footprints layer's gp_id), and how many id lists a DBF
+  // cuts (the CLI says so after writing).
+  const bool dbf = max_id_list_chars > 0;
+  plan_of_.assign(fps.size(), 0);
+  for (std::size_t i = 0; i < r.plans.size(); ++i) {
+    std::size_t chars = 0, n = 0;
+    for (std::uint32_t m : r.plans[i].members) {
+      if (m >= fps.size()) continue;
+      plan_of_[m] = static_cast<GIntBig>(i + 1);
+      chars += (n++ ? 1 : 0) + fps[m].source_id.size();
+    }
+    id_lists_cut_ += dbf && chars > max_id_list_chars;
+  }
+  const GIntBig* plan_of = plan_of_.data();
 
-  auto plans = std::make_unique<OGRGroundPlanLayer>("ground_plans", wkbPolygon, srs);
+  // DBF field names hold 10 characters: say what GDAL would otherwise launder with a warning.
+  const char* ids_field = dbf ? "bldg_ids" : "building_ids";
+  const char* file_field = dbf ? "src_file" : "source_file";
+  auto plans = std::make_unique<OGRGroundPlanLayer>(
+      "ground_plans", wkbPolygon, srs, r.plans.size(),
+      [res, max_id_list_chars](OGRFeatureDefn* defn, std::size_t i) {
+        const GroundPlan& gp = res->plans[i];
+        const auto& fps = res->footprints;
+        auto* f = new OGRFeature(defn);
+        std::string ids;
+        double zmin = 0, zmax = 0;
+        bool first = true;
+        for (std::uint32_t m : gp.members) {
+          if (m >= fps.size()) continue;
+          if (!ids.empty()) ids += ',';
+          ids += fps[m].source_id;
+          zmin = first ? fps[m].min_z : std::min(zmin, fps[m].min_z);
+          zmax = first ? fps[m].max_z : std::max(zmax, fps[m].max_z);
+          first = false;
+        }
+        f->SetField(0, static_cast<GIntBig>(i + 1));
+        f->SetField(1, static_cast<int>(gp.members.size()));
+        f->SetField(2, gp.area_m2);
+        if (!first) {
+          f->SetField(3, zmin);
+          f->SetField(4, zmax);
+        }
+        f->SetField(5, cut_id_list(ids, gp.members.size(), max_id_list_chars).c_str());
+        f->SetGeometryDirectly(to_ogr_polygon(gp.polygon));
+        return f;
+      },
+      [res] {
+        return envelope_of([&](auto&& ring) {
+          for (const GroundPlan& gp : res->plans) ring(gp.polygon.outer);
+        });
+      },
+      threads);
   add_field(plans->defn(), "gp_id", OFTInteger64);
   add_field(plans->defn(), "n_parts", OFTInteger);
   add_field(plans->defn(), "area_m2", OFTReal);
   add_field(plans->defn(), "min_z", OFTReal);
   add_field(plans->defn(), "max_z", OFTReal);
-  // DBF field names hold 10 characters: say what GDAL would otherwise launder with a warning.
-  const bool dbf = max_id_list_chars > 0;
-  const char* ids_field = dbf ? "bldg_ids" : "building_ids";
-  const char* file_field = dbf ? "src_file" : "source_file";
   add_field(plans->defn(), ids_field, OFTString);
-  for (std::size_t i = 0; i < result.plans.size(); ++i) {
-    const GroundPlan& gp = result.plans[i];
-    auto f = std::make_unique<OGRFeature>(plans->defn());
-    std::string ids;
-    double zmin = 0, zmax = 0;
-    bool first = true;
-    for (std::uint32_t m : gp.members) {
-      if (m >= fps.size()) continue;
-      plan_of[m] = static_cast<GIntBig>(i + 1);
-      if (!ids.empty()) ids += ',';
-      ids += fps[m].source_id;
-      zmin = first ? fps[m].min_z : std::min(zmin, fps[m].min_z);
-      zmax = first ? fps[m].max_z : std::max(zmax, fps[m].max_z);
-      first = false;
-    }
-    f->SetField("gp_id", static_cast<GIntBig>(i + 1));
-    f->SetField("n_parts", static_cast<int>(gp.members.size()));
-    f->SetField("area_m2", gp.area_m2);
-    if (!first) {
-      f->SetField("min_z", zmin);
-      f->SetField("max_z", zmax);
-    }
-    const std::string shown = cut_id_list(ids, gp.members.size(), max_id_list_chars);
-    id_lists_cut_ += shown.size() != ids.size();
-    f->SetField(ids_field, shown.c_str());
-    f->SetGeometryDirectly(to_ogr_polygon(gp.polygon));
-    plans->add(std::move(f));
-  }
 
-  auto footprints = std::make_unique<OGRGroundPlanLayer>("footprints", wkbMultiPolygon, srs);
+  auto footprints = std::make_unique<OGRGroundPlanLayer>(
+      "footprints", wkbMultiPolygon, srs, fps.size(),
+      [res, plan_of](OGRFeatureDefn* defn, std::size_t i) {
+        const Footprint& fp = res->footprints[i];
+        auto* f = new OGRFeature(defn);
+        f->SetField(0, static_cast<GIntBig>(i + 1));
+        f->SetField(1, fp.source_id.c_str());
+        f->SetField(2, fp.source_file.c_str());
+        f->SetField(3, fp.method.c_str());
+        if (plan_of[i]) f->SetField(4, plan_of[i]);
+        f->SetField(5, fp.min_z);
+        f->SetField(6, fp.max_z);
+        auto* mp = new OGRMultiPolygon();
+        for (const Polygon& p : fp.polygons) mp->addGeometryDirectly(to_ogr_polygon(p));
+        f->SetGeometryDirectly(mp);
+        return f;
+      },
+      [res] {
+        return envelope_of([&](auto&& ring) {
+          for (const Footprint& fp : res->footprints)
+            for (const Polygon& p : fp.polygons) ring(p.outer);
+        });
+      },
+      threads);
   add_field(footprints->defn(), "fp_id", OFTInteger64);
   add_field(footprints->defn(), "source_id", OFTString);
   add_field(footprints->defn(), file_field, OFTString);
@@ -115,48 +168,44 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   add_field(footprints->defn(), "gp_id", OFTInteger64);
   add_field(footprints->defn(), "min_z", OFTReal);
   add_field(footprints->defn(), "max_z", OFTReal);
-  for (std::size_t i = 0; i < fps.size(); ++i) {
-    auto f = std::make_unique<OGRFeature>(footprints->defn());
-    f->SetField("fp_id", static_cast<GIntBig>(i + 1));
-    f->SetField("source_id", fps[i].source_id.c_str());
-    f->SetField(file_field, fps[i].source_file.c_str());
-    f->SetField("method", fps[i].method.c_str());
-    if (plan_of[i]) f->SetField("gp_id", plan_of[i]);
-    f->SetField("min_z", fps[i].min_z);
-    f->SetField("max_z", fps[i].max_z);
-    auto* mp = new OGRMultiPolygon();
-    for (const Polygon& p : fps[i].polygons) mp->addGeometryDirectly(to_ogr_polygon(p));
-    f->SetGeometryDirectly(mp);
-    footprints->add(std::move(f));
-  }
+
+  auto problems = std::make_unique<OGRGroundPlanLayer>(
+      "problems", wkbNone, nullptr, r.problems.size(),
+      [res](OGRFeatureDefn* defn, std::size_t i) {
+        const Problem& p = res->problems[i];
+        auto* f = new OGRFeature(defn);
+        f->SetField(0, p.source_id.c_str());
+        f->SetField(1, p.file.c_str());
+        f->SetField(2, p.stage.c_str());
+        f->SetField(3, p.code.c_str());
+        f->SetField(4, p.reason.c_str());
+        return f;
+      },
+      OGRGroundPlanLayer::Extent{}, threads);
+  for (const char* name : {"source_id", "file", "stage", "code", "reason"}) add_field(problems->defn(), name, OFTString);
 
   // One row per (plan, member): the full lists in a form every format holds.
-  auto members = std::make_unique<OGRGroundPlanLayer>("plan_members", wkbNone, nullptr);
+  struct Member {
+    std::uint32_t plan, footprint;
+  };
+  auto rows = std::make_shared<std::vector<Member>>();
+  for (std::size_t i = 0; i < r.plans.size(); ++i)
+    for (std::uint32_t m : r.plans[i].members)
+      if (m < fps.size()) rows->push_back({static_cast<std::uint32_t>(i), m});
+  auto members = std::make_unique<OGRGroundPlanLayer>(
+      "plan_members", wkbNone, nullptr, rows->size(),
+      [res, rows](OGRFeatureDefn* defn, std::size_t i) {
+        const Member& m = (*rows)[i];
+        auto* f = new OGRFeature(defn);
+        f->SetField(0, static_cast<GIntBig>(m.plan) + 1);
+        f->SetField(1, static_cast<GIntBig>(m.footprint) + 1);
+        f->SetField(2, res->footprints[m.footprint].source_id.c_str());
+        return f;
+      },
+      OGRGroundPlanLayer::Extent{}, threads);
   add_field(members->defn(), "gp_id", OFTInteger64);
   add_field(members->defn(), "fp_id", OFTInteger64);
   add_field(members->defn(), "source_id", OFTString);
-  for (std::size_t i = 0; i < result.plans.size(); ++i) {
-    for (std::uint32_t m : result.plans[i].members) {
-      if (m >= fps.size()) continue;
-      auto f = std::make_unique<OGRFeature>(members->defn());
-      f->SetField("gp_id", static_cast<GIntBig>(i + 1));
-      f->SetField("fp_id", static_cast<GIntBig>(m + 1));
-      f->SetField("source_id", fps[m].source_id.c_str());
-      members->add(std::move(f));
-    }
-  }
-
-  auto problems = std::make_unique<OGRGroundPlanLayer>("problems", wkbNone, nullptr);
-  for (const char* name : {"source_id", "file", "stage", "code", "reason"}) add_field(problems->defn(), name, OFTString);
-  for (const Problem& p : result.problems) {
-    auto f = std::make_unique<OGRFeature>(problems->defn());
-    f->SetField("source_id", p.source_id.c_str());
-    f->SetField("file", p.file.c_str());
-    f->SetField("stage", p.stage.c_str());
-    f->SetField("code", p.code.c_str());
-    f->SetField("reason", p.reason.c_str());
-    problems->add(std::move(f));
-  }
 
   layers_.push_back(std::move(plans));
   layers_.push_back(std::move(footprints));
@@ -182,8 +231,8 @@ GDALDataset* OGRGroundPlanDataSource::Open(GDALOpenInfo* info) {
   // Entry point: convert exceptions once, here (STYLE.md §4).
   try {
     const gis::PipelineOptions options = pipeline_options_from(info->pszFilename, info->papszOpenOptions);
-    const gis::PipelineResult result = gis::run_pipeline(options);
-    return new OGRGroundPlanDataSource(info->pszFilename, result);
+    auto result = std::make_shared<const gis::PipelineResult>(gis::run_pipeline(options));
+    return new OGRGroundPlanDataSource(info->pszFilename, std::move(result), 0, options.threads);
   } catch (const std::exception& e) {
     CPLError(CE_Failure, CPLE_AppDefined, "GroundPlan: %s", e.what());
     return nullptr;

@@ -7,11 +7,18 @@
 #include <groundplan/gis/pipeline.h>
 #include <groundplan/gis/reader.h>
 
+#include "pipeline/file_reading.h"
+
+#include <cpl_string.h>
+#include <cpl_vsi.h>
+#include <sys/resource.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <deque>
 #include <filesystem>
@@ -34,9 +41,9 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF;
+/// Files named by the inputs: a file as is, a folder or a .zip as its input files (CityGML, KML/KMZ, glTF;
 /// not .dae, which belong to a .kml beside them) sorted by name.
-std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
     std::error_code ec;
@@ -48,6 +55,32 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
       if (found.empty())
         throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb)");
       files.insert(files.end(), found.begin(), found.end());
+    } else if (lower(fs::path(in).extension().string()) == ".zip") {
+      // A zip of tiles: its input entries, sorted (read through GDAL's /vsizip/, side by side like a folder).
+      const std::string root = in.rfind("/vsizip/", 0) == 0 ? in : "/vsizip/" + in;
+      std::vector<std::string> found;
+      char** list = VSIReadDirRecursive(root.c_str());
+      for (char** e = list; e && *e; ++e) {
+        const std::string entry(*e);
+        const bool escapes = entry.empty() || entry[0] == '/' || entry[0] == '\\' || entry.find("..") != std::string::npos;
+        // GDAL 3.6's listing already leaves out "../x" and "/x"; checked again, and said, in case another does not.
+        if (escapes && is_input_name(entry))
+          problems.push_back({"", in, "read", "UNSAFE_PATH",
+                              "zip entry \"" + entry.substr(0, 200) + "\" names a path outside the archive; not read"});
+        else if (is_input_name(entry))
+          found.push_back(root + "/" + entry);
+      }
+      CSLDestroy(list);
+      if (!fs::exists(in, ec) && in.rfind("/vsi", 0) != 0) throw InputError(in + ": no such file or folder");
+      std::sort(found.begin(), found.end());
+      if (found.empty() && ogr_can_read(in)) {  // parts.shp.zip: a dataset GDAL reads (issue 22), not tiles
+        files.push_back(in);
+        continue;
+      }
+      if (found.empty())
+        throw InputError(in + ": the zip holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb), or "
+                              "is not a zip");
+      files.insert(files.end(), found.begin(), found.end());
     } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0 || looks_like_connection_string(in)) {
       files.push_back(in);
     } else {
@@ -55,15 +88,6 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
     }
   }
   return files;
-}
-
-FootprintSource to_core(FootprintMode m) {
-  switch (m) {
-    case FootprintMode::Auto: return FootprintSource::Auto;
-    case FootprintMode::GroundSurface: return FootprintSource::GroundSurface;
-    case FootprintMode::Decompose: return FootprintSource::Decompose;
-  }
-  return FootprintSource::Auto;
 }
 
 }  // namespace
@@ -117,6 +141,16 @@ AxisOrder axis_order_from_string(const std::string& s) {
   throw InvalidArgument("axis order: '" + s + "' is not one of auto, east-north, north-east");
 }
 
+int threads_from_string(const std::string& s, const std::string& what) {
+  const std::string l = lower(s);
+  if (l == "all_cpus" || l == "0") return 0;
+  int n = 0;
+  const auto [end, ec] = std::from_chars(l.data(), l.data() + l.size(), n);
+  if (ec != std::errc() || end != l.data() + l.size() || n < 1)
+    throw InvalidArgument(what + "=" + s + ": not a number of threads (1, 2, ... or ALL_CPUS)");
+  return n;
+}
+
 bool raster_mode_from_string(const std::string& s) {
   const std::string l = lower(s);
   if (l == "exact") return false;
@@ -124,194 +158,103 @@ bool raster_mode_from_string(const std::string& s) {
   throw InvalidArgument("resolution mode: '" + s + "' is not one of exact, raster");
 }
 
-PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress) {
-  PipelineResult result;
-  const std::vector<std::string> files = expand_inputs(options.inputs);
+namespace {
 
-  ReadOptions read_options;
-  read_options.lod = options.lod;
-  read_options.origin = options.origin;
-  read_options.ogr = options.ogr_input;
-  FootprintParams footprint_params;
-  footprint_params.source = to_core(options.footprints);
+double cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+std::uint64_t total_bytes(const std::vector<std::string>& files) {
+  std::uint64_t total = 0;
+  for (const std::string& f : files) {
+    VSIStatBufL st;
+    if (VSIStatL(f.c_str(), &st) == 0) total += static_cast<std::uint64_t>(st.st_size);
+  }
+  return total;
+}
+
+/// Adds one file's outcome to the result, in file order, and fixes the working CRS from it the way
+/// reading the files one after the other always has: the first georeferenced file decides (or -t_srs).
+void merge_file(detail::FileRead&& r, const std::string& file, detail::ReadContext& context, PipelineResult& result,
+                std::size_t& files_failed, std::string& first_failure) {
+  result.timings.footprints_s += r.footprint_wait_s;
+  result.buildings_read += r.buildings_read;
+  result.buildings_dropped += r.buildings_dropped;
+  std::move(r.footprints.begin(), r.footprints.end(), std::back_inserter(result.footprints));
+  std::move(r.problems.begin(), r.problems.end(), std::back_inserter(result.problems));
+  if (r.failed) {
+    ++files_failed;
+    if (first_failure.empty()) first_failure = r.failure;
+  }
+  auto take = [&](const WorkingCrs& crs) {
+    if (!result.crs_wkt.empty() || !crs.known || !context.unknown_frame_file.empty()) return;
+    result.crs_wkt = crs.wkt;
+    result.crs_name = crs.epsg ? "EPSG:" + std::to_string(crs.epsg) : crs.name;
+    if (context.working_definition.empty()) context.working_definition = crs.definition;
+  };
+  if (r.in_working_crs) take(r.reader_crs);
+  // A file without CRS keeps its coordinates as written; after that, no georeferenced file can join it
+  // (and before it, none can: WorkingFrame refuses an unknown source once a target is set).
+  if (r.has_frame && !r.frame_source_known && r.delivered && context.working_definition.empty() &&
+      context.unknown_frame_file.empty())
+    context.unknown_frame_file = file;
+  if (r.has_frame) take(r.frame_crs);
+  if (r.chunks) {
+    ++result.reading.files_chunked;
+    result.reading.chunks += r.chunks;
+  } else if (!r.whole_reason.empty()) {
+    result.reading.read_whole.emplace_back(file, r.whole_reason);
+  }
+}
+
+PipelineResult run(const PipelineOptions& options, const Progress& progress, std::size_t threads) {
+  const double cpu0 = cpu_seconds();
+  PipelineResult result;
+  const std::vector<std::string> files = expand_inputs(options.inputs, result.problems);
+  result.reading.files = files.size();
+  result.reading.threads = threads;
+  result.reading.bytes = total_bytes(files);
 
   // One working CRS for all inputs: the first file decides it (or -t_srs does); later files are
-  // transformed into it.
-  std::string working_definition = options.t_srs;
-  // A file without CRS keeps its coordinates as written; after that, no georeferenced file can join
-  // it (and before it, none can: WorkingFrame refuses an unknown source once a target is set).
-  std::string unknown_frame_file;
+  // transformed into it. Until it is known the files are read one by one (each may still be read in
+  // chunks side by side); from then on a file's reading depends on nothing read before it, so the
+  // rest are read side by side and merged in file order: the same result as one by one.
+  detail::ReadContext context;
+  context.working_definition = options.t_srs;
   std::size_t files_failed = 0;
   std::string first_failure;
-
   const auto t_read = clock_type::now();
-  double footprint_s = 0;
-  // Footprints are made on the other cores while this thread reads on (DESIGN.md: one machine, all
-  // cores), each into its slot in reading order, so the output and the problems come out exactly as
-  // if made one by one. When too many wait, the reader makes the next one itself: memory stays
-  // bounded (a slot holds its mesh until its footprint is made).
-  struct Slot {
-    Mesh mesh;                    // until its footprint is made
-    std::size_t file = 0;         // index into files
-    std::size_t problem_pos = 0;  // where its problem goes among the others (result.problems.size() then)
-    FootprintResult fp;           // fp.footprint.source_id names the building, made or not
-  };
-  std::deque<Slot> slots;  // stable addresses: a task holds a pointer to its slot
-  tbb::task_group footprint_tasks;
-  std::atomic<std::size_t> pending{0};
-  auto make = [&footprint_params](Slot& s) {
-    s.fp = make_footprint(s.mesh, footprint_params);
-    s.mesh = Mesh{};
-  };
-  const std::size_t max_pending = 16 * static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
-  struct WaitOnExit {  // the tasks use this frame's locals: never leave it with one still running
-    tbb::task_group& g;
-    ~WaitOnExit() {
-      g.cancel();
-      try {
-        g.wait();
-      } catch (...) {
-      }
+  detail::ByteProgress bytes(progress.sub(0, 0.6), result.reading.bytes);
+  progress.report(0, "reading");
+  std::size_t fi = 0;
+  for (; fi < files.size() && context.working_definition.empty(); ++fi)
+    merge_file(detail::read_file(files[fi], options, context, threads, bytes), files[fi], context, result,
+               files_failed, first_failure);
+  if (fi < files.size()) {
+    // Largest first, so that a big file does not start last; at most one task a thread in flight, so
+    // memory holds the footprints kept and one reading per thread.
+    std::vector<std::size_t> order(files.size() - fi);
+    std::vector<std::uint64_t> size(files.size(), 0);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      order[k] = fi + k;
+      VSIStatBufL st;
+      if (VSIStatL(files[fi + k].c_str(), &st) == 0) size[fi + k] = static_cast<std::uint64_t>(st.st_size);
     }
-  } wait_on_exit{footprint_tasks};
-  for (std::size_t fi = 0; fi < files.size(); ++fi) {
-    const std::string& file = files[fi];
-    const Progress file_progress = progress.sub(0.6 * static_cast<double>(fi) / static_cast<double>(files.size()),
-                                                0.6 * static_cast<double>(fi + 1) / static_cast<double>(files.size()));
-    file_progress.report(0, "reading");
-    ReadInfo info;
-    std::unique_ptr<WorkingFrame> frame;
-    read_options.target_srs = working_definition;  // KML/glTF are placed by the reader, in this CRS
-    std::unordered_set<std::string> delivered;  // ids of this file's meshes (for the given-up count below)
-    const std::size_t first_problem = result.problems.size();
-    auto on_mesh = [&](Mesh&& mesh) {
-      ++result.buildings_read;
-      delivered.insert(mesh.source_id);
-      std::string reason;
-      bool placed = true;
-      try {
-        if (!info.in_working_crs && !frame) {
-          CrsOptions crs;
-          crs.target_srs = working_definition;
-          // --axis-order wins; else the order the format fixes (OGR: GDAL's data axis order), else the CRS's rule.
-          crs.source_axis = options.source_axis != AxisOrder::Auto ? options.source_axis : info.source_axis;
-          frame = std::make_unique<WorkingFrame>(info.source_srs, crs, file);
-        }
-        const bool georeferenced = info.in_working_crs || (frame && frame->source_known());
-        if (georeferenced && !unknown_frame_file.empty())
-          throw InvalidArgument(file + ": has a CRS, but " + unknown_frame_file +
-                                " (read before it) has none, so their coordinates cannot be combined; give every "
-                                "input a CRS, or process them separately");
-        placed = !frame || frame->transform(mesh, &reason);
-      } catch (const Error& e) {
-        // The file's CRS cannot hold this building (EPSG:4326 on metres ...): the file's fault, so the
-        // file stops here (the caller's catch); this building is named too, so that it is not lost.
-        result.problems.push_back({mesh.source_id, file, "georeference", "CRS_MISMATCH", e.what()});
-        ++result.buildings_dropped;
-        throw;
-      }
-      if (!placed) {
-        result.problems.push_back({mesh.source_id, file, "georeference", "TRANSFORM_FAILED", reason});
-        ++result.buildings_dropped;
-        return;
-      }
-      Slot& slot = slots.emplace_back();
-      slot.mesh = std::move(mesh);
-      slot.file = fi;
-      slot.problem_pos = result.problems.size();
-      if (pending.load(std::memory_order_relaxed) >= max_pending) {
-        const auto t_fp = clock_type::now();
-        make(slot);
-        footprint_s += seconds_since(t_fp);
-      } else {
-        pending.fetch_add(1, std::memory_order_relaxed);
-        footprint_tasks.run([&make, &pending, s = &slot] {
-          make(*s);
-          pending.fetch_sub(1, std::memory_order_relaxed);
-        });
-      }
-      if ((result.buildings_read & 1023) == 0) file_progress.report(0.5, "reading");
-    };
-    try {
-      read_any(file, read_options, on_mesh, result.problems, info);
-    } catch (const Cancelled&) {
-      throw;
-    } catch (const InputError& e) {
-      // One unreadable file does not stop the others; it is a problem of its own. Buildings read
-      // before the fault stay (a truncated file).
-      ++files_failed;
-      if (first_failure.empty()) first_failure = e.what();
-      result.problems.push_back({"", file, "read", "UNREADABLE_FILE", e.what()});
-    } catch (const InvalidArgument& e) {
-      // The file's CRS cannot go to the working CRS (its srsName unknown while the first file, or
-      // -t_srs, fixed one): the same, a problem of this file. A bad -t_srs fails every file, so the run.
-      ++files_failed;
-      if (first_failure.empty()) first_failure = e.what();
-      result.problems.push_back({"", file, "georeference", "UNREADABLE_FILE", e.what()});
-    }
-    // Buildings the reader gave up count as read and dropped: nothing is lost silently. Whatever the
-    // format, such a building is named by a read-stage Problem and gave no mesh (a building that did
-    // give one may have read-stage defects too: a dropped face, a missing xlink).
-    std::unordered_set<std::string> given_up;
-    for (std::size_t k = first_problem; k < result.problems.size(); ++k) {
-      const Problem& p = result.problems[k];
-      if (p.stage == "read" && !p.source_id.empty() && p.code != "NOTE" && !delivered.count(p.source_id))
-        given_up.insert(p.source_id);
-    }
-    result.buildings_read += given_up.size();
-    result.buildings_dropped += given_up.size();
-    if (info.in_working_crs) {
-      for (const std::string& note : info.notes) result.problems.push_back({"", file, "georeference", "NOTE", note});
-      if (result.crs_wkt.empty() && info.working_crs.known && unknown_frame_file.empty()) {
-        result.crs_wkt = info.working_crs.wkt;
-        result.crs_name = info.working_crs.epsg ? "EPSG:" + std::to_string(info.working_crs.epsg) : info.working_crs.name;
-        if (working_definition.empty()) working_definition = info.working_crs.definition;
-      }
-    }
-    if (frame && !frame->source_known() && !delivered.empty() && working_definition.empty() &&
-        unknown_frame_file.empty())
-      unknown_frame_file = file;
-    if (frame) {
-      for (const std::string& note : frame->notes()) result.problems.push_back({"", file, "georeference", "NOTE", note});
-      if (result.crs_wkt.empty() && frame->working_crs().known && unknown_frame_file.empty()) {
-        result.crs_wkt = frame->working_crs().wkt;
-        result.crs_name = frame->working_crs().epsg ? "EPSG:" + std::to_string(frame->working_crs().epsg)
-                                                    : frame->working_crs().name;
-        if (working_definition.empty()) working_definition = frame->working_crs().definition;
-      }
-    }
-  }
-  // read: the reading thread's time less the footprints it made itself; footprints: those, and the
-  // wait for the rest after reading (the time they added to the run, not their CPU time).
-  const double read_s = seconds_since(t_read) - footprint_s;
-  const auto t_wait = clock_type::now();
-  footprint_tasks.wait();
-  footprint_s += seconds_since(t_wait);
-  // In reading order: each footprint, or its problem where it would have stood had it been made
-  // on the spot.
-  {
-    std::vector<Problem> problems;
-    problems.reserve(result.problems.size() + slots.size());
-    std::size_t next = 0;  // next problem of result.problems to copy
-    for (Slot& slot : slots) {
-      FootprintResult& fp = slot.fp;
-      if (fp.ok) {
-        fp.footprint.source_file = files[slot.file];
-        fp.footprint.method = to_string(fp.method);
-        result.footprints.push_back(std::move(fp.footprint));
-        continue;
-      }
-      for (; next < slot.problem_pos; ++next) problems.push_back(std::move(result.problems[next]));
-      problems.push_back({fp.footprint.source_id, files[slot.file], "footprint", fp.code, fp.reason});
-      ++result.buildings_dropped;
-    }
-    for (; next < result.problems.size(); ++next) problems.push_back(std::move(result.problems[next]));
-    result.problems = std::move(problems);
-    slots.clear();
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
+    std::vector<detail::FileRead> reads(files.size());
+    const detail::ReadContext fixed = context;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k)
+        reads[order[k]] = detail::read_file(files[order[k]], options, fixed, threads, bytes);
+    }, tbb::simple_partitioner());
+    for (; fi < files.size(); ++fi)
+      merge_file(std::move(reads[fi]), files[fi], context, result, files_failed, first_failure);
   }
   if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
-  result.timings.footprints_s = footprint_s;
-  result.timings.read_s = read_s;
+  result.timings.read_s = std::max(0.0, seconds_since(t_read) - result.timings.footprints_s);
 
   const auto t_union = clock_type::now();
   UnionStats union_stats;
@@ -325,7 +268,25 @@ PipelineResult run_pipeline(const PipelineOptions& options, const Progress& prog
   result.timings.lod_s = ls.snap_s + ls.close_s + ls.raster_s + ls.simplify_s + ls.filter_s;
   result.timings.blocks_s = union_stats.blocks_s;
   result.timings.union_s = seconds_since(t_union) - union_stats.blocks_s - result.timings.lod_s;
+  result.timings.cpu_s = cpu_seconds() - cpu0;
   progress.report(1.0, "done");
+  return result;
+}
+
+}  // namespace
+
+std::size_t thread_count(int requested) {
+  if (requested > 0) return static_cast<std::size_t>(requested);
+  return static_cast<std::size_t>(std::max(1, tbb::info::default_concurrency()));
+}
+
+PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress) {
+  if (options.threads < 0) throw InvalidArgument("threads: " + std::to_string(options.threads) + " is not >= 1 (0 = all cores)");
+  const std::size_t threads = thread_count(options.threads);
+  // Every stage's parallel work runs in this arena, so --threads bounds all of them.
+  tbb::task_arena arena(static_cast<int>(threads));
+  PipelineResult result;
+  arena.execute([&] { result = run(options, progress, threads); });
   return result;
 }
 

@@ -112,6 +112,7 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
     opt.lod = options.lod;
+    opt.on_bytes = options.on_bytes;
     read_citygml(path, opt, [&](Mesh&& m) {
       ++info.meshes;
       if (info.source_srs != info.citygml.srs_name) info.source_srs = info.citygml.srs_name;

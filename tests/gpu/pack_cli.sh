@@ -8,8 +8,11 @@ set -eu
 BUILD=${1:?BUILD_DIR}; OUTF=${2:?OUT.tar.xz}; shift 2
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
 mkdir -p "$T/gp/bin" "$T/gp/lib" "$T/gp/share" "$T/gp/data"
-cp "$BUILD/bin/groundplan" "$T/gp/bin/"
-ldd "$BUILD/bin/groundplan" | awk '$3 ~ /^\// {print $3}' | while read -r lib; do
+# PACK_EXTRA_BINS: other programs to pack with it (ogr2ogr, as a baseline for the writer).
+bins=("$BUILD/bin/groundplan")
+for b in ${PACK_EXTRA_BINS:-}; do bins+=("$(command -v "$b")"); done
+cp "${bins[@]}" "$T/gp/bin/"
+for b in "${bins[@]}"; do ldd "$b"; done | awk '$3 ~ /^\// {print $3}' | sort -u | while read -r lib; do
   case "$(basename "$lib")" in
     libc.so*|libm.so*|libstdc++.so*|libgcc_s.so*|ld-linux*|libpthread.so*|libdl.so*|librt.so*|libcuda.so*) ;;
     *) cp -L "$lib" "$T/gp/lib/" ;;

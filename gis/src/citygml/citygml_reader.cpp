@@ -12,8 +12,10 @@
 // back (bounded) until a later building defines the target.
 #include <groundplan/error.h>
 #include <groundplan/gis/citygml.h>
+#include <groundplan/gis/citygml_chunks.h>
 
 #include "citygml/coordinates.h"
+#include "citygml/file_problems.h"
 
 #include <cpl_vsi.h>
 #include <expat.h>
@@ -276,9 +278,11 @@ void copy_faces(const Mesh& from, std::uint32_t first, std::uint32_t last, Mesh&
 
 class Reader {
  public:
+  /// `watch`: set when this reader reads one chunk of a file (citygml_chunks.h); it then records what
+  /// could make the chunk read differently from the whole file, and leaves file-level problems out.
   Reader(const std::string& name, const CityGmlOptions& opt, const MeshCallback& cb, std::vector<Problem>& problems,
-         SourceInfo& info)
-      : name_(name), opt_(opt), cb_(cb), problems_(problems), info_(info) {
+         SourceInfo& info, CityGmlChunkWatch* watch = nullptr)
+      : name_(name), opt_(opt), cb_(cb), problems_(problems), info_(info), watch_(watch) {
     info_.file = name;
     parser_ = XML_ParserCreateNS(nullptr, kSep);
     if (!parser_) throw Error("out of memory creating the XML parser");
@@ -309,12 +313,13 @@ class Reader {
   }
 
   /// Reads straight into expat's buffer (no copy). Returns bytes read.
+  /// `may_end`: a read of 0 bytes is the end of the document (false: the caller ends it).
   template <class ReadFn>
-  std::size_t feed_from(ReadFn&& read) {
+  std::size_t feed_from(ReadFn&& read, bool may_end = true) {
     void* buf = XML_GetBuffer(parser_, kChunk);
     if (!buf) throw Error("out of memory in the XML parser reading " + name_);
     std::size_t n = read(buf, static_cast<std::size_t>(kChunk));
-    parse_buffer(n, n == 0);
+    parse_buffer(n, may_end && n == 0);
     return n;
   }
 
@@ -326,16 +331,7 @@ class Reader {
       give_up_refs(*ctx);
       deliver(std::move(ctx));
     }
-    if (info_.citygml_version.empty()) {
-      problems_.push_back(Problem{"", name_, "read", "NOT_CITYGML",
-                                  "no CityGML namespace (http://www.opengis.net/citygml/...) in the file: "
-                                  "nothing read from it"});
-    }
-    if (info_.srs_mixed) {
-      problems_.push_back(Problem{"", name_, "read", "MIXED_SRS",
-                                  "the file uses srsName \"" + info_.srs_name + "\" and also \"" +
-                                      info_.other_srs_name + "\"; every coordinate is taken as in the first"});
-    }
+    if (!watch_) detail::add_file_problems(info_, name_, problems_);  // chunks: merge_citygml_chunks says them
   }
 
  private:
@@ -683,6 +679,7 @@ class Reader {
       b->defect("BAD_SRS_DIMENSION", reason);
     } else if (!bad_dimension_said_) {
       bad_dimension_said_ = true;
+      if (watch_) watch_->file_level_problem = true;
       problems_.push_back(Problem{"", name_, "read", "BAD_SRS_DIMENSION", reason});
     }
   }
@@ -720,7 +717,9 @@ class Reader {
         ctx->defect("DUPLICATE_ID", "gml:id \"" + ctx->mesh.source_id +
                                         "\" is used by an earlier building of the file too; both are kept (tell them "
                                         "apart by fp_id in the footprints layer)");
+      if (watch_) watch_->building_ids.push_back(ctx->mesh.source_id);
     } else {
+      if (watch_) watch_->position_dependent = true;  // the id holds a running count and a line number
       ctx->mesh.source_id = std::string(is_part ? "BuildingPart" : "Building") + "#" +
                             std::to_string(info_.buildings + info_.building_parts) + "@line" +
                             std::to_string(XML_GetCurrentLineNumber(parser_));
@@ -764,8 +763,13 @@ class Reader {
         ++info_.xlinks_resolved;
         continue;
       }
-      if (resolve_from_open(ctx, r) || resolve_from_index(ctx, r)) {
+      if (resolve_from_open(ctx, r)) {
         ++info_.xlinks_resolved;
+        continue;
+      }
+      if (resolve_from_index(ctx, r)) {
+        ++info_.xlinks_resolved;
+        if (watch_) watch_->cross_building_xlink = true;  // the target may sit in an earlier chunk
         continue;
       }
       left.push_back(std::move(r));
@@ -795,6 +799,7 @@ class Reader {
   }
 
   void give_up_refs(BuildingCtx& ctx) {
+    if (watch_ && !ctx.refs.empty()) watch_->cross_building_xlink = true;  // the target may sit in another chunk
     for (const XRef& r : ctx.refs) {
       ++info_.xlinks_missing;
       ctx.defect("XLINK_TARGET_MISSING", "xlink:href=\"#" + r.id +
@@ -832,7 +837,10 @@ class Reader {
       BuildingCtx& p = *pending_[k];
       std::vector<XRef> left;
       for (XRef& r : p.refs) {
-        if (resolve_from(ib.mesh, ib.side, ib.ids, p, r)) ++info_.xlinks_resolved;
+        if (resolve_from(ib.mesh, ib.side, ib.ids, p, r)) {
+          ++info_.xlinks_resolved;
+          if (watch_) watch_->cross_building_xlink = true;
+        }
         else left.push_back(std::move(r));
       }
       p.refs = std::move(left);
@@ -952,6 +960,7 @@ class Reader {
   }
 
   std::string poly_label() const {
+    if (watch_ && poly_id_.empty()) watch_->position_dependent = true;
     return poly_id_.empty() ? "at line " + std::to_string(XML_GetCurrentLineNumber(parser_)) : "\"" + poly_id_ + "\"";
   }
 
@@ -979,6 +988,7 @@ class Reader {
         } else if (f.dim) {
           dim = f.dim;
         } else {
+          if (watch_) watch_->dimension_defaults |= 1u << info_.srs_dimension;
           dim = detail::infer_dimension(coords_, 0, info_.srs_dimension ? info_.srs_dimension : 3);
         }
         if ((dim != 2 && dim != 3) || coords_.size() % static_cast<std::size_t>(dim) != 0)
@@ -1060,6 +1070,7 @@ class Reader {
   const MeshCallback& cb_;
   std::vector<Problem>& problems_;
   SourceInfo& info_;
+  CityGmlChunkWatch* watch_ = nullptr;
   XML_Parser parser_ = nullptr;
   std::exception_ptr pending_exception_;
   std::string stop_reason_;
@@ -1096,17 +1107,42 @@ class Reader {
 
 }  // namespace
 
+namespace detail {
+void add_file_problems(const SourceInfo& info, const std::string& name, std::vector<Problem>& problems) {
+  if (info.citygml_version.empty()) {
+    problems.push_back(Problem{"", name, "read", "NOT_CITYGML",
+                               "no CityGML namespace (http://www.opengis.net/citygml/...) in the file: "
+                               "nothing read from it"});
+  }
+  if (info.srs_mixed) {
+    problems.push_back(Problem{"", name, "read", "MIXED_SRS",
+                               "the file uses srsName \"" + info.srs_name + "\" and also \"" + info.other_srs_name +
+                                   "\"; every coordinate is taken as in the first"});
+  }
+}
+}  // namespace detail
+
+namespace {
+struct VsiClose {
+  void operator()(VSILFILE* f) const { VSIFCloseL(f); }
+};
+using VsiHandle = std::unique_ptr<VSILFILE, VsiClose>;
+
+VsiHandle open_file(const std::string& path) {
+  VsiHandle f(VSIFOpenL(path.c_str(), "rb"));
+  if (!f) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+  return f;
+}
+}  // namespace
+
 void read_citygml(const std::string& path, const CityGmlOptions& options, const MeshCallback& on_mesh,
                   std::vector<Problem>& problems, SourceInfo& info) {
-  VSILFILE* fp = VSIFOpenL(path.c_str(), "rb");
-  if (!fp) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
-  struct Closer {
-    VSILFILE* f;
-    ~Closer() { VSIFCloseL(f); }
-  } closer{fp};
+  const VsiHandle file = open_file(path);
+  VSILFILE* fp = file.get();
   Reader reader(path, options, on_mesh, problems, info);
   for (;;) {
     std::size_t n = reader.feed_from([&](void* buf, std::size_t cap) { return VSIFReadL(buf, 1, cap, fp); });
+    if (options.on_bytes && n) options.on_bytes(n);
     if (n == 0) break;
   }
   reader.finish();
@@ -1121,6 +1157,30 @@ void read_citygml_buffer(std::string_view xml, const std::string& name, const Ci
     reader.feed(xml.data() + off, n, false);
     off += n;
   } while (off < xml.size());
+  reader.feed(nullptr, 0, true);
+  reader.finish();
+}
+
+void read_citygml_chunk(const std::string& path, const CityGmlChunkPlan& plan, std::size_t k,
+                        const CityGmlOptions& options, const MeshCallback& on_mesh, std::vector<Problem>& problems,
+                        SourceInfo& info, CityGmlChunkWatch& watch) {
+  const auto [begin, end] = plan.ranges.at(k);
+  const bool last = k + 1 == plan.ranges.size();
+  const VsiHandle file = open_file(path);
+  VSILFILE* fp = file.get();
+  if (VSIFSeekL(fp, begin, SEEK_SET) != 0) throw InputError(path + ": cannot seek to byte " + std::to_string(begin));
+  Reader reader(path, options, on_mesh, problems, info, &watch);
+  reader.feed(plan.head.data(), plan.head.size(), false);
+  std::uint64_t left = end - begin;
+  while (left > 0) {
+    const std::size_t n = reader.feed_from([&](void* buf, std::size_t cap) {
+      return VSIFReadL(buf, 1, static_cast<std::size_t>(std::min<std::uint64_t>(cap, left)), fp);
+    }, false);
+    if (n == 0) throw InputError(path + ": the file ends before byte " + std::to_string(end) + " (changed while read?)");
+    left -= n;
+    if (options.on_bytes) options.on_bytes(n);
+  }
+  if (!last) reader.feed(plan.tail.data(), plan.tail.size(), false);
   reader.feed(nullptr, 0, true);
   reader.finish();
 }

@@ -39,6 +39,8 @@ struct CityGmlOptions {
   /// A polygon with a coordinate beyond this magnitude is dropped (COORDINATE_OUT_OF_RANGE): no CRS on
   /// Earth has values past 1e9 (metres or degrees); such numbers would only break the later stages.
   double max_abs_coordinate = 1e9;
+  /// Told the bytes of the file as they are read (progress across files); may be empty.
+  std::function<void(std::uint64_t)> on_bytes;
 };
 
 /// What the reader learnt about one file.

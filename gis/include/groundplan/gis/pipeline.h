@@ -9,7 +9,9 @@
 #include <groundplan/progress.h>
 #include <groundplan/types.h>
 
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace groundplan::gis {
@@ -27,13 +29,31 @@ struct PipelineOptions {
   OgrInputOptions ogr_input;        // OGR sources (issue 22): --input-layer, --input-where, --id-field, --group-by ...
   UnionParams union_params;
   LodParams detail;                 // level of detail for simulation (issue 9); default: the exact union
+  int threads = 0;                  // threads for every stage: --threads, NUM_THREADS=, GDAL_NUM_THREADS; 0 = all cores
+  /// CityGML files are cut into chunks of about this many bytes, read side by side (issue 14): 0 = automatic
+  /// (about four chunks a thread, 2-64 MiB; never with one thread), < 0 = never. The result is the same either way.
+  std::int64_t read_chunk_bytes = 0;
+};
+
+/// How the inputs were read (--stats "reading").
+struct ReadStats {
+  std::size_t files = 0;
+  std::size_t threads = 0;          // threads the run used
+  std::size_t files_chunked = 0;    // CityGML files read in chunks side by side
+  std::size_t chunks = 0;           // their chunks
+  std::uint64_t bytes = 0;          // bytes of all input files
+  /// CityGML files read whole although cutting was allowed, and why (small files are not listed).
+  std::vector<std::pair<std::string, std::string>> read_whole;
 };
 
 struct StageTimings {
-  // footprints_s: the time footprints added to the run (they are made on the other cores while the
-  // file is read; this is what the reader made itself plus the wait after reading), not CPU time.
+  // read_s: wall time of reading, georeferencing and the footprints made while reading (files and chunks
+  // are read side by side, each making its footprints) less footprints_s: the waits for footprints still
+  // being made after a file's last byte (files read whole; summed over them). Wall times, not CPU time
+  // (cpu_s is the whole run's CPU time).
   double read_s = 0, footprints_s = 0, blocks_s = 0, union_s = 0;  // union_s: boundary evaluation only
   double lod_s = 0;  // level-of-detail steps (snap, close gaps, simplify, filters)
+  double cpu_s = 0;  // CPU time of the process (all threads) during run_pipeline: close to the work done
 };
 
 struct PipelineResult {
@@ -50,12 +70,16 @@ struct PipelineResult {
   std::string crs_name;               // e.g. "EPSG:25833", for messages
   StageTimings timings;
   LodStats lod_stats;                 // what the level-of-detail steps changed (all zero when off)
+  ReadStats reading;
 };
 
 /// Runs read -> footprints -> union. Throws InputError when no input can be read at all (every file
 /// unreadable and no footprint from any: a truncated file still gives the buildings before the cut), Cancelled
 /// when `progress` asks to stop. A bad building is a Problem, not an exception.
 PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
+
+/// Threads a run uses: `requested` when > 0, else all cores (TBB's default concurrency).
+std::size_t thread_count(int requested);
 
 const char* to_string(FootprintMode mode);
 FootprintMode footprint_mode_from_string(const std::string& s);  // throws InvalidArgument
@@ -66,6 +90,9 @@ Device device_from_string(const std::string& s);                 // throws Inval
 LodParams lod_preset(const std::string& name);
 /// "auto", "east-north" (x = longitude / easting) or "north-east": --axis-order, AXIS_ORDER=. Throws InvalidArgument.
 AxisOrder axis_order_from_string(const std::string& s);
+/// GDAL's GDAL_NUM_THREADS / NUM_THREADS= form: "ALL_CPUS" or "0" -> 0 (all cores), "N" -> N >= 1.
+/// Throws InvalidArgument naming `what` (the option) otherwise.
+int threads_from_string(const std::string& s, const std::string& what);
 /// "exact" (false) or "raster" (true): --resolution-mode, RESOLUTION_MODE=. Throws InvalidArgument.
 bool raster_mode_from_string(const std::string& s);
 

@@ -19,6 +19,8 @@
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -35,6 +37,7 @@ struct ReadOptions {
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
   OgrInputOptions ogr;          // any OGR vector source: layers, filter, ids, grouping (issue 22)
+  std::function<void(std::uint64_t)> on_bytes;  // CityGML: told the bytes as they are read (progress); may be empty
 };
 
 struct ReadInfo {

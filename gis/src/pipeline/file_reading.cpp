@@ -1,0 +1,421 @@
+// SPDX-License-Identifier: MIT
+// One file through read -> working frame -> footprints (issue 14). A CityGML file of two chunks or
+// more is read in chunks side by side (citygml_chunks.h) and the result checked against what the
+// whole-file reading would give; otherwise, and when that check fails, the file is read whole, its
+// footprints made on the other cores while the reader reads on.
+#include "pipeline/file_reading.h"
+
+#include <groundplan/error.h>
+#include <groundplan/gis/citygml_chunks.h>
+#include <groundplan/gis/reader.h>
+
+#include <cpl_vsi.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <unordered_set>
+
+namespace groundplan::gis::detail {
+namespace {
+
+FootprintSource to_core(FootprintMode m) {
+  switch (m) {
+    case FootprintMode::Auto: return FootprintSource::Auto;
+    case FootprintMode::GroundSurface: return FootprintSource::GroundSurface;
+    case FootprintMode::Decompose: return FootprintSource::Decompose;
+  }
+  return FootprintSource::Auto;
+}
+
+/// The meshes of one reading (a whole file, or one chunk of it) and their footprints, in reading order.
+struct Part {
+  struct Slot {
+    Mesh mesh;                    // until its footprint is made
+    std::size_t problem_pos = 0;  // where its problem goes among the others (problems.size() then)
+    FootprintResult fp;           // fp.footprint.source_id names the building, made or not
+  };
+  std::vector<Problem> problems;
+  std::deque<Slot> slots;  // stable addresses: a footprint task holds a pointer to its slot
+  std::size_t buildings_read = 0, buildings_dropped = 0;
+  std::unordered_set<std::string> delivered;  // ids of the meshes read
+};
+
+/// Georeferences the meshes of one reading as the whole-file reading does: CityGML meshes through one
+/// WorkingFrame, made at the first mesh from the srsName known then (KML and glTF meshes arrive placed).
+class Placer {
+ public:
+  /// A frame kept by a thread between the chunks of one file it reads: made once, not once a chunk
+  /// (making one costs tens of ms when PROJ must find the operation, e.g. geographic to UTM).
+  struct Kept {
+    std::string srs;
+    std::unique_ptr<WorkingFrame> frame;
+  };
+
+  /// `decision`: where the file's first mesh fixed the working CRS (for a chunk after that mesh).
+  /// `kept`: a frame to take when its srsName is the one this reading needs, and to give back at the end.
+  Placer(const std::string& file, const PipelineOptions& options, const ReadContext& context,
+         const bool& in_working_crs, const SourceInfo& citygml, std::optional<std::array<double, 2>> decision = {},
+         Kept* kept = nullptr, const ReadInfo* read_info = nullptr)
+      : file_(file), options_(options), context_(context), in_working_crs_(in_working_crs), citygml_(citygml),
+        decision_(decision), kept_(kept), read_info_(read_info) {}
+  ~Placer() {
+    if (kept_ && frame) {
+      kept_->srs = frame_srs;
+      kept_->frame = std::move(frame);
+    }
+  }
+  Placer(const Placer&) = delete;
+  Placer& operator=(const Placer&) = delete;
+
+  /// False when the mesh cannot be placed (a Problem says why); throws when the file's CRS cannot
+  /// hold it (the building is named by a Problem, and the file stops there).
+  bool place(Mesh& mesh, Part& part) {
+    ++part.buildings_read;
+    part.delivered.insert(mesh.source_id);
+    std::string reason;
+    bool placed = true;
+    try {
+      if (!in_working_crs_ && !frame) {
+        CrsOptions crs;
+        crs.target_srs = context_.working_definition;
+        // --axis-order wins; else the order the format fixes (OGR: GDAL's data axis order), else the CRS's rule.
+        const AxisOrder format_axis = read_info_ ? read_info_->source_axis : AxisOrder::Auto;
+        crs.source_axis = options_.source_axis != AxisOrder::Auto ? options_.source_axis : format_axis;
+        frame_srs = read_info_ ? read_info_->source_srs : citygml_.srs_name;  // OGR sources: the layer's CRS
+        if (kept_ && kept_->frame && kept_->srs == frame_srs)
+          frame = std::move(kept_->frame);  // same srsName, options and decision: the same frame
+        else
+          frame = std::make_unique<WorkingFrame>(frame_srs, crs, file_);
+        if (decision_ && !frame->decided()) frame->decide((*decision_)[0], (*decision_)[1]);
+      }
+      const bool georeferenced = in_working_crs_ || (frame && frame->source_known());
+      if (georeferenced && !context_.unknown_frame_file.empty())
+        throw InvalidArgument(file_ + ": has a CRS, but " + context_.unknown_frame_file +
+                              " (read before it) has none, so their coordinates cannot be combined; give every "
+                              "input a CRS, or process them separately");
+      if (frame && !frame->decided() && !mesh.vertices.empty()) {
+        // What WorkingFrame::transform would decide from; kept for the chunks after this one.
+        double lo_x = mesh.vertices[0].x, hi_x = lo_x, lo_y = mesh.vertices[0].y, hi_y = lo_y;
+        for (const Point3& p : mesh.vertices) {
+          lo_x = std::min(lo_x, p.x), hi_x = std::max(hi_x, p.x);
+          lo_y = std::min(lo_y, p.y), hi_y = std::max(hi_y, p.y);
+        }
+        decided_at = std::array<double, 2>{(lo_x + hi_x) / 2, (lo_y + hi_y) / 2};
+        frame->decide((*decided_at)[0], (*decided_at)[1]);
+      }
+      placed = !frame || frame->transform(mesh, &reason);
+    } catch (const Error& e) {
+      // The file's CRS cannot hold this building (EPSG:4326 on metres ...): the file's fault, so the
+      // file stops here (the caller's catch); this building is named too, so that it is not lost.
+      part.problems.push_back({mesh.source_id, file_, "georeference", "CRS_MISMATCH", e.what()});
+      ++part.buildings_dropped;
+      throw;
+    }
+    if (!placed) {
+      part.problems.push_back({mesh.source_id, file_, "georeference", "TRANSFORM_FAILED", reason});
+      ++part.buildings_dropped;
+    }
+    return placed;
+  }
+
+  std::unique_ptr<WorkingFrame> frame;
+  std::string frame_srs;                             // the srsName the frame was made from
+  std::optional<std::array<double, 2>> decided_at;   // set when this reading's first mesh fixed the working CRS
+
+ private:
+  const std::string& file_;
+  const PipelineOptions& options_;
+  const ReadContext& context_;
+  const bool& in_working_crs_;
+  const SourceInfo& citygml_;
+  std::optional<std::array<double, 2>> decision_;
+  Kept* kept_ = nullptr;
+  const ReadInfo* read_info_ = nullptr;  // whole-file reading: the CRS any format gives (ReadInfo::source_srs)
+};
+
+/// Footprints on the other cores while the reader reads on, each into its slot in reading order, so
+/// that the output and the problems come out exactly as if made one by one. When too many wait, the
+/// reader makes the next one itself: memory stays bounded (a slot holds its mesh until then).
+class FootprintMaker {
+ public:
+  FootprintMaker(const PipelineOptions& options, bool spawn) : spawn_(spawn) {
+    params_.source = to_core(options.footprints);
+    max_pending_ = 16 * static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  }
+  ~FootprintMaker() {  // the tasks use the slots: never leave with one still running
+    tasks_.cancel();
+    try {
+      tasks_.wait();
+    } catch (...) {
+    }
+  }
+  void add(Mesh&& mesh, Part& part) {
+    Part::Slot& slot = part.slots.emplace_back();
+    slot.mesh = std::move(mesh);
+    slot.problem_pos = part.problems.size();
+    if (!spawn_ || pending_.load(std::memory_order_relaxed) >= max_pending_) {
+      make(slot);
+      return;
+    }
+    pending_.fetch_add(1, std::memory_order_relaxed);
+    tasks_.run([this, s = &slot] {
+      make(*s);
+      pending_.fetch_sub(1, std::memory_order_relaxed);
+    });
+  }
+  void wait() { tasks_.wait(); }
+
+ private:
+  void make(Part::Slot& s) const {
+    s.fp = make_footprint(s.mesh, params_);
+    s.mesh = Mesh{};
+  }
+  FootprintParams params_;
+  bool spawn_;
+  std::size_t max_pending_;
+  std::atomic<std::size_t> pending_{0};
+  tbb::task_group tasks_;
+};
+
+/// Appends a part (its footprints made) to the file's outcome, problems in reading order.
+/// The ids of the meshes read, one set a part (not merged: that would be a serial pass over every id).
+using Delivered = std::vector<std::unordered_set<std::string>>;
+
+void append(Part& part, const std::string& file, FileRead& out, Delivered& delivered) {
+  std::size_t next = 0;  // next problem of part.problems to copy
+  for (Part::Slot& slot : part.slots) {
+    FootprintResult& fp = slot.fp;
+    if (fp.ok) {
+      fp.footprint.source_file = file;
+      fp.footprint.method = to_string(fp.method);
+      out.footprints.push_back(std::move(fp.footprint));
+      continue;
+    }
+    for (; next < slot.problem_pos; ++next) out.problems.push_back(std::move(part.problems[next]));
+    out.problems.push_back({fp.footprint.source_id, file, "footprint", fp.code, fp.reason});
+    ++out.buildings_dropped;
+  }
+  for (; next < part.problems.size(); ++next) out.problems.push_back(std::move(part.problems[next]));
+  out.buildings_read += part.buildings_read;
+  out.buildings_dropped += part.buildings_dropped;
+  delivered.push_back(std::move(part.delivered));
+  part = Part{};
+}
+
+/// The file's last words: buildings the reader gave up, notes, and the CRS facts for the pipeline.
+void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info,
+                 const WorkingFrame* frame, const std::string& file) {
+  // Buildings the reader gave up count as read and dropped: nothing is lost silently. Whatever the
+  // format, such a building is named by a read-stage Problem and gave no mesh (a building that did
+  // give one may have read-stage defects too: a dropped face, a missing xlink).
+  auto was_delivered = [&](const std::string& id) {
+    return std::any_of(delivered.begin(), delivered.end(), [&](const auto& set) { return set.count(id) > 0; });
+  };
+  std::unordered_set<std::string> given_up;
+  for (const Problem& p : out.problems)
+    if (p.stage == "read" && !p.source_id.empty() && p.code != "NOTE" && !given_up.count(p.source_id) &&
+        !was_delivered(p.source_id))
+      given_up.insert(p.source_id);
+  out.buildings_read += given_up.size();
+  out.buildings_dropped += given_up.size();
+  out.delivered = std::any_of(delivered.begin(), delivered.end(), [](const auto& set) { return !set.empty(); });
+  if (info.in_working_crs) {
+    for (const std::string& note : info.notes) out.problems.push_back({"", file, "georeference", "NOTE", note});
+    out.in_working_crs = true;
+    out.reader_crs = info.working_crs;
+  }
+  if (frame) {
+    for (const std::string& note : frame->notes()) out.problems.push_back({"", file, "georeference", "NOTE", note});
+    out.has_frame = true;
+    out.frame_source_known = frame->source_known();
+    out.frame_crs = frame->working_crs();
+  }
+}
+
+/// The whole file, one building after the other (footprints on the other cores).
+FileRead read_whole(const std::string& file, const PipelineOptions& options, const ReadContext& context,
+                    ByteProgress& bytes) {
+  FileRead out;
+  Part part;
+  ReadInfo info;
+  ReadOptions read_options;
+  read_options.lod = options.lod;
+  read_options.origin = options.origin;
+  read_options.ogr = options.ogr_input;
+  read_options.target_srs = context.working_definition;  // KML/glTF are placed by the reader, in this CRS
+  bool counted_bytes = false;
+  read_options.on_bytes = [&](std::uint64_t n) {
+    counted_bytes = true;
+    bytes.add(n);
+  };
+  Placer placer(file, options, context, info.in_working_crs, info.citygml, {}, nullptr, &info);
+  {
+    FootprintMaker maker(options, true);
+    try {
+      read_any(file, read_options, [&](Mesh&& mesh) {
+        if (placer.place(mesh, part)) maker.add(std::move(mesh), part);
+      }, part.problems, info);
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const InputError& e) {
+      // One unreadable file does not stop the others; it is a problem of its own. Buildings read
+      // before the fault stay (a truncated file).
+      out.failed = true;
+      out.failure = e.what();
+      part.problems.push_back({"", file, "read", "UNREADABLE_FILE", e.what()});
+    } catch (const InvalidArgument& e) {
+      // The file's CRS cannot go to the working CRS (its srsName unknown while the first file, or
+      // -t_srs, fixed one): the same, a problem of this file. A bad -t_srs fails every file, so the run.
+      out.failed = true;
+      out.failure = e.what();
+      part.problems.push_back({"", file, "georeference", "UNREADABLE_FILE", e.what()});
+    }
+    const auto t_wait = std::chrono::steady_clock::now();
+    maker.wait();
+    out.footprint_wait_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_wait).count();
+  }
+  if (!counted_bytes) {
+    VSIStatBufL st;
+    if (VSIStatL(file.c_str(), &st) == 0) bytes.add(static_cast<std::uint64_t>(st.st_size));
+  }
+  Delivered delivered;
+  append(part, file, out, delivered);
+  finish_file(out, delivered, info, placer.frame.get(), file);
+  return out;
+}
+
+/// The chunks of `plan` side by side; nullopt (and `why`) when they do not read the file as
+/// read_whole does.
+std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkPlan& plan,
+                                    const PipelineOptions& options, const ReadContext& context, ByteProgress& bytes,
+                                    std::string& why) {
+  const std::size_t n = plan.ranges.size();
+  std::vector<Part> parts(n);
+  std::vector<SourceInfo> infos(n);
+  std::vector<CityGmlChunkWatch> watches(n);
+  std::vector<std::unique_ptr<Placer>> placers(n);
+  std::vector<std::optional<std::string>> frame_srs(n);  // what each chunk's frame was made from, if it made one
+  tbb::enumerable_thread_specific<Placer::Kept> kept;
+  std::vector<std::string> errors(n);
+  CityGmlOptions citygml;
+  citygml.lod = options.lod;
+  citygml.on_bytes = [&bytes](std::uint64_t b) { bytes.add(b); };
+  const bool in_working_crs = false;
+  std::atomic<bool> failed{false};
+  auto read_chunk = [&](std::size_t k, std::optional<std::array<double, 2>> decision, bool keep) {
+    if (failed.load(std::memory_order_relaxed)) return;
+    placers[k] = std::make_unique<Placer>(file, options, context, in_working_crs, infos[k], decision,
+                                          keep ? &kept.local() : nullptr);
+    FootprintMaker maker(options, false);  // the chunks keep every core busy already
+    try {
+      read_citygml_chunk(file, plan, k, citygml, [&](Mesh&& mesh) {
+        if (placers[k]->place(mesh, parts[k])) maker.add(std::move(mesh), parts[k]);
+      }, parts[k].problems, infos[k], watches[k]);
+    } catch (const Cancelled&) {
+      throw;
+    } catch (const std::exception& e) {
+      errors[k] = e.what();
+      failed = true;
+    }
+    if (placers[k]->frame) frame_srs[k] = placers[k]->frame_srs;
+    if (keep) placers[k].reset();  // its frame goes back to the thread for its next chunk
+  };
+  // The chunks before the first placed building, one by one: that building may fix the working CRS
+  // (the UTM zone of its centre), which every chunk after it must use as the whole-file reading does.
+  std::size_t k = 0;
+  const Placer* first = nullptr;  // the chunk whose frame stands for the file's
+  while (k < n && !failed) {
+    read_chunk(k, {}, false);
+    const Placer& p = *placers[k++];
+    if (p.frame && !first) first = &p;
+    if (p.frame && p.frame->decided()) {
+      first = &p;
+      break;
+    }
+  }
+  const std::optional<std::array<double, 2>> decision = first ? first->decided_at : std::nullopt;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(k, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) read_chunk(i, decision, true);
+  }, tbb::simple_partitioner());
+  for (std::size_t i = 0; i < n; ++i)
+    if (!errors[i].empty()) {
+      why = "chunk " + std::to_string(i + 1) + " of " + std::to_string(n) + ": " + errors[i];
+      return std::nullopt;
+    }
+  for (std::size_t i = 0; i < n; ++i)
+    if (first && frame_srs[i] && *frame_srs[i] != first->frame_srs) {
+      why = "the srsName before the first building differs between chunks";
+      return std::nullopt;
+    }
+  SourceInfo merged;
+  std::vector<Problem> file_problems;
+  why = merge_citygml_chunks(file, plan, infos, watches, merged, file_problems);
+  if (!why.empty()) return std::nullopt;
+
+  FileRead out;
+  Delivered delivered;
+  for (Part& part : parts) append(part, file, out, delivered);
+  out.problems.insert(out.problems.end(), file_problems.begin(), file_problems.end());
+  ReadInfo info;
+  info.citygml = merged;
+  finish_file(out, delivered, info, first ? first->frame.get() : nullptr, file);
+  out.chunks = n;
+  return out;
+}
+
+/// Bytes per chunk for a file of `size` read with `threads` threads: about four chunks a thread,
+/// 2-64 MiB each (a chunk re-reads the file's head, and a thread should not wait on one huge chunk).
+std::uint64_t auto_chunk_bytes(std::uint64_t size, std::size_t threads) {
+  const std::uint64_t per = size / (4 * std::max<std::size_t>(threads, 1));
+  return std::clamp<std::uint64_t>(per, std::uint64_t{2} << 20, std::uint64_t{64} << 20);
+}
+
+}  // namespace
+
+void ByteProgress::add(std::uint64_t n) {
+  const std::uint64_t done = done_.fetch_add(n, std::memory_order_relaxed) + n;
+  if (!progress_ || done < next_report_.load(std::memory_order_relaxed)) return;
+  std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return;
+  next_report_.store(done + total_ / 200 + 1, std::memory_order_relaxed);
+  progress_.report(total_ ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total_)) : 1.0, "reading");
+}
+
+FileRead read_file(const std::string& file, const PipelineOptions& options, const ReadContext& context,
+                   std::size_t threads, ByteProgress& bytes) {
+  std::string whole_reason;
+  const bool may_cut = options.read_chunk_bytes >= 0 && (options.read_chunk_bytes > 0 || threads > 1);
+  if (may_cut && detect_format(file) == InputFormat::CityGml) {
+    VSIStatBufL st;
+    if (VSIStatL(file.c_str(), &st) == 0) {
+      const auto size = static_cast<std::uint64_t>(st.st_size);
+      const std::uint64_t chunk = options.read_chunk_bytes > 0 ? static_cast<std::uint64_t>(options.read_chunk_bytes)
+                                                               : auto_chunk_bytes(size, threads);
+      if (size >= 2 * chunk) {
+        try {
+          const CityGmlChunkPlan plan = plan_citygml_chunks(file, chunk, std::min<std::uint64_t>(chunk, 1 << 20));
+          whole_reason = plan.why_not;
+          if (plan.why_not.empty()) {
+            std::optional<FileRead> chunked = read_chunks(file, plan, options, context, bytes, whole_reason);
+            if (chunked) return std::move(*chunked);
+          }
+        } catch (const InputError& e) {
+          whole_reason = e.what();  // read_whole says it again, as a problem of the file
+        }
+      }
+    }
+  }
+  FileRead out = read_whole(file, options, context, bytes);
+  out.whole_reason = std::move(whole_reason);
+  return out;
+}
+
+}  // namespace groundplan::gis::detail

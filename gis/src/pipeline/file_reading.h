@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// Stages 1-3 for one input file (read, georeference, footprints), self-contained so that files, and
+// chunks of one CityGML file, are read side by side (issue 14). The pipeline merges the FileReads in
+// file order; each is exactly what reading that file alone, one building after the other, gives.
+#include <groundplan/footprint.h>
+#include <groundplan/gis/crs.h>
+#include <groundplan/gis/pipeline.h>
+#include <groundplan/progress.h>
+#include <groundplan/types.h>
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace groundplan::gis::detail {
+
+/// What one file's reading depends on from the files read before it. Fixed once a working CRS is
+/// known (then later files are read side by side); before that the files are read one by one.
+struct ReadContext {
+  std::string working_definition;  // -t_srs, or the first georeferenced file's working CRS
+  std::string unknown_frame_file;  // a file read before without CRS (georeferenced files cannot join it)
+};
+
+/// One file's outcome, merged into the PipelineResult in file order.
+struct FileRead {
+  std::vector<Footprint> footprints;  // in reading order
+  std::vector<Problem> problems;      // in reading order, each footprint's problem where it was made, notes last
+  std::size_t buildings_read = 0, buildings_dropped = 0;
+  bool failed = false;                // the file could not be read (or not to its end): an UNREADABLE_FILE problem
+  std::string failure;                // its message
+  // CRS facts the pipeline needs (in file order) to fix the working CRS for the files after it.
+  bool delivered = false;             // a mesh came out
+  bool in_working_crs = false;        // KML / glTF: placed by the reader
+  WorkingCrs reader_crs;              // their working CRS
+  bool has_frame = false;             // CityGML: a WorkingFrame was made
+  bool frame_source_known = false;
+  WorkingCrs frame_crs;
+  // How it was read (--stats).
+  std::size_t chunks = 0;             // > 0: CityGML read in this many chunks side by side
+  std::string whole_reason;           // CityGML read whole although cutting was asked for: why
+  double footprint_wait_s = 0;        // read whole: the wait for its footprints after its last byte
+};
+
+/// Bytes read across all files, for -progress: reported from any thread, a few hundred times at most.
+class ByteProgress {
+ public:
+  ByteProgress(Progress progress, std::uint64_t total_bytes) : progress_(std::move(progress)), total_(total_bytes) {}
+  void add(std::uint64_t n);  // throws Cancelled when the user cancels
+ private:
+  Progress progress_;
+  std::uint64_t total_;
+  std::atomic<std::uint64_t> done_{0};
+  std::atomic<std::uint64_t> next_report_{0};
+  std::mutex mutex_;
+};
+
+/// Reads one file (a CityGML file of at least two chunks in chunks side by side, unless
+/// options.read_chunk_bytes < 0). Never throws for the file's content (a failure is in FileRead);
+/// throws Cancelled.
+FileRead read_file(const std::string& file, const PipelineOptions& options, const ReadContext& context,
+                   std::size_t threads, ByteProgress& bytes);
+
+}  // namespace groundplan::gis::detail

@@ -1,0 +1,76 @@
+#!/bin/bash
+# Issue 14's benchmark on the 16-core GPU host (no GDAL there: the CLI and ogr2ogr come packed by
+# tests/gpu/pack_cli.sh with PACK_EXTRA_BINS=ogr2ogr). A generated LoD1 city (tests/bench/gen_big_citygml.py)
+# as one file and as 16 tiles of the same buildings (split_citygml_tiles.py): end to end with all cores
+# and with --threads 1, reading scaling over 1..16 threads, the GeoPackage writer against ogr2ogr copying
+# the same features, CPU time and peak RSS (/usr/bin/time), and the outputs' hashes (the same whatever
+# the threads or the cut). Usage, from the repository root:
+#   tests/bench/city_scale_on_device.sh BUNDLE.tar.xz [CITY_MB] [BIG_CITY_MB]
+set -u
+BUNDLE=${1:?BUNDLE}; MB=${2:-1500}; BIG_MB=${3:-0}
+OUT=${OUT:-city-scale-out}; mkdir -p "$OUT"
+exec > >(tee "$OUT/city_scale.log") 2>&1
+W=/tmp/gp-city; rm -rf "$W"; mkdir -p "$W"
+xz -dc "$BUNDLE" | tar -C "$W" -xf - || { echo "cannot unpack $BUNDLE"; exit 1; }
+G=$W/gp
+export LD_LIBRARY_PATH=$G/lib GDAL_DATA=$G/share/gdal PROJ_DATA=$G/share/proj PROJ_LIB=$G/share/proj
+echo "== machine"; date -u; nproc; lscpu | grep -m1 "Model name"; free -g | head -2
+$G/bin/groundplan --version || { ldd $G/bin/groundplan | grep "not found"; exit 1; }
+
+line() {  # NAME STATS.json TIME.txt -> one line
+  python3 - "$@" <<'PY'
+import json, sys
+name, stats, tm = sys.argv[1:4]
+d = json.load(open(stats)); t = d["timings_s"]; r = d.get("reading", {})
+wall, user, sys_, rss = open(tm).read().split()[-4:]
+print("%-22s wall %6.2f s | read %6.2f fp %5.2f blocks %5.2f union %5.2f write %5.2f | cpu %6.1f s | rss %5.0f MiB | "
+      "threads %s chunked %s/%s files, %s chunks | plans %s" % (name, float(wall), t["read"], t["footprints"], t["blocks"],
+      t["union"], t["write"], float(user) + float(sys_), int(rss) / 1024, r.get("threads"), r.get("files_chunked"),
+      r.get("files"), r.get("chunks"), d["counts"]["ground_plans"]))
+PY
+}
+gp() {  # NAME ARGS... : one run, its line
+  local name=$1; shift
+  rm -rf "$W/$name.gpkg" "$W/$name.csv"
+  /usr/bin/time -f "%e %U %S %M" -o "$W/$name.time" $G/bin/groundplan -q --device cpu --stats "$W/$name.json" "$@"
+  local rc=$?
+  [ $rc = 0 ] && line "$name" "$W/$name.json" "$W/$name.time" || echo "$name: exit $rc"
+}
+
+echo "== city: gen_big_citygml.py $MB MB, split into 16 tiles"
+s=$(date +%s); python3 tests/bench/gen_big_citygml.py "$W/city.gml" "$MB" | tail -1
+python3 tests/bench/split_citygml_tiles.py "$W/city.gml" 16 "$W/tiles" | tail -1; echo "  made in $(( $(date +%s) - s )) s"
+cat "$W/city.gml" > /dev/null; cat "$W"/tiles/* > /dev/null  # in the page cache, as for every run below
+
+echo "== same output whatever the threads and the cut (ground_plans as CSV WKT)"
+gp csv_t1 -f CSV -lco GEOMETRY=AS_WKT "$W/csv_t1.csv" "$W/city.gml" --threads 1
+gp csv_t16 -f CSV -lco GEOMETRY=AS_WKT "$W/csv_t16.csv" "$W/city.gml"
+gp csv_tiles -f CSV -lco GEOMETRY=AS_WKT "$W/csv_tiles.csv" "$W/tiles"
+md5sum "$W"/csv_t1.csv "$W"/csv_t16.csv "$W"/csv_tiles.csv | sed "s#$W/##"
+
+echo "== end to end to GeoPackage (3 runs each with all cores)"
+for i in 1 2 3; do gp "file_all_$i" -f GPKG "$W/file_all_$i.gpkg" "$W/city.gml"; done
+for i in 1 2 3; do gp "tiles_all_$i" -f GPKG "$W/tiles_all_$i.gpkg" "$W/tiles"; done
+gp file_t1 -f GPKG "$W/file_t1.gpkg" "$W/city.gml" --threads 1
+gp tiles_t1 -f GPKG "$W/tiles_t1.gpkg" "$W/tiles" --threads 1
+
+echo "== the writer against ogr2ogr copying the same features (GPKG -> GPKG)"
+if [ -x $G/bin/ogr2ogr ]; then
+  for i in 1 2 3; do
+    rm -f "$W/copy.gpkg"; s=$(date +%s%N)
+    $G/bin/ogr2ogr -f GPKG "$W/copy.gpkg" "$W/file_all_1.gpkg" ground_plans
+    echo "ogr2ogr copy of ground_plans: $(( ($(date +%s%N) - s) / 1000000 )) ms (rc $?)"
+  done
+fi
+
+echo "== reading scaling (one file, CSV output; 1 and 16 threads: csv_t1, csv_t16 above)"
+for t in 2 4 8; do gp "scale_t$t" -f CSV -lco GEOMETRY=AS_WKT "$W/scale_t$t.csv" "$W/city.gml" --threads $t; done
+
+if [ "$BIG_MB" != 0 ]; then
+  echo "== big city: $BIG_MB MB"
+  rm -rf "$W/tiles" "$W"/*.gpkg "$W"/*.csv
+  s=$(date +%s); python3 tests/bench/gen_big_citygml.py "$W/big.gml" "$BIG_MB" | tail -1; echo "  made in $(( $(date +%s) - s )) s"
+  cat "$W/big.gml" > /dev/null
+  gp big_all -f GPKG "$W/big.gpkg" "$W/big.gml"
+fi
+echo "== done"
