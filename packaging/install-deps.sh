@@ -19,6 +19,8 @@ packages=(
   libcli11-dev nlohmann-json3-dev libtbb-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev python3-pytest
+  # the GeoPandas/Shapely baseline of the OGR-input benchmark (issue 22, tests/bench/ogr_input_bench.sh)
+  python3-geopandas
   # fuzzing (libFuzzer with clang; tests/fuzz) and the sanitizer runtime's symbolizer
   clang libclang-rt-14-dev llvm
 )

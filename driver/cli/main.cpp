@@ -314,6 +314,15 @@ int run(int argc, char** argv) {
   app.add_option("--axis-order", axis_order,
                  "auto|east-north|north-east: CityGML axis order when a file breaks its CRS's rule (e.g. EPSG:4979 "
                  "written lon,lat); auto follows the CRS");
+  // OGR sources (issue 22): named --input-* so that ogr2ogr's -sql/-where/layer names keep meaning the output.
+  groundplan::gis::OgrInputOptions ogr_in;
+  app.add_option("--input-layer", ogr_in.layers, "OGR source: a layer to read (repeat for more; default: all)");
+  app.add_option("--input-where", ogr_in.where, "OGR source: attribute filter on the layers read (OGR SQL WHERE)");
+  app.add_option("--input-sql", ogr_in.sql, "OGR source: SQL statement whose result layer is read");
+  app.add_option("--input-dialect", ogr_in.dialect, "OGR source: dialect of --input-sql (OGRSQL, SQLITE)");
+  app.add_option("--input-oo", ogr_in.open_options, "OGR source: NAME=VALUE open option of its driver (repeatable)");
+  app.add_option("--id-field", ogr_in.id_field, "OGR source: field holding the building id (default: the FID)");
+  app.add_option("--group-by", ogr_in.group_by, "OGR source: features sharing this field's value are one building");
   app.add_option("--lod", lod, "Level of detail to read: -1 (highest per building), 0..4, or with CityJSON's "
                                "refinement as 3DBAG names it (1.2, 1.3, 2.2)");
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
@@ -386,6 +395,7 @@ int run(int argc, char** argv) {
   options.lod_refinement = lod_choice.refinement;
   options.origin = origin;
   options.source_axis = groundplan::gis::axis_order_from_string(axis_order);
+  options.ogr_input = ogr_in;
   options.detail = groundplan::gis::lod_preset(o_preset->count() ? preset : "none");
   if (o_mode->count()) options.detail.raster = groundplan::gis::raster_mode_from_string(resolution_mode);
   if (o_snap->count()) options.detail.snap_m = lod_flags.snap_m;

@@ -54,6 +54,13 @@ const char* open_option_list_xml() {
          "listed in the problems layer (0 = off)' default='0'/>"
          "  <Option name='SIMPLIFY' type='float' description='Metres: topology-preserving simplification tolerance "
          "(0 = off)' default='0'/>"
+         "  <Option name='INPUT_LAYERS' type='string' description='OGR sources: comma-separated layers to read (default: all)'/>"
+         "  <Option name='INPUT_WHERE' type='string' description='OGR sources: attribute filter on the layers read (OGR SQL WHERE)'/>"
+         "  <Option name='INPUT_SQL' type='string' description='OGR sources: SQL statement whose result layer is read'/>"
+         "  <Option name='INPUT_DIALECT' type='string' description='OGR sources: dialect of INPUT_SQL (OGRSQL, SQLITE)'/>"
+         "  <Option name='INPUT_OO' type='string' description='OGR sources: comma-separated NAME=VALUE open options of the source driver'/>"
+         "  <Option name='ID_FIELD' type='string' description='OGR sources: field holding the building id (default: the FID)'/>"
+         "  <Option name='GROUP_BY' type='string' description='OGR sources: features sharing this field&apos;s value are one building'/>"
          "  <Option name='NUM_THREADS' type='string' description='Threads for every stage: a number or ALL_CPUS "
          "(default: the GDAL_NUM_THREADS config option, else all cores)' default='ALL_CPUS'/>"
          "</OpenOptionList>";
@@ -117,6 +124,20 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
   lod_value("SIMPLIFY", &o.detail.simplify_m);
   if (const char* v = CSLFetchNameValue(open_options, "ORIGIN")) o.origin = v;
   if (const char* v = CSLFetchNameValue(open_options, "AXIS_ORDER")) o.source_axis = gis::axis_order_from_string(v);
+  auto list = [&](const char* name) {
+    std::vector<std::string> out;
+    const CPLStringList parts(CSLTokenizeString2(CSLFetchNameValueDef(open_options, name, ""), ",", CSLT_HONOURSTRINGS));
+    for (int i = 0; i < parts.size(); ++i)
+      if (*parts[i]) out.emplace_back(parts[i]);
+    return out;
+  };
+  o.ogr_input.layers = list("INPUT_LAYERS");
+  o.ogr_input.open_options = list("INPUT_OO");
+  o.ogr_input.where = CSLFetchNameValueDef(open_options, "INPUT_WHERE", "");
+  o.ogr_input.sql = CSLFetchNameValueDef(open_options, "INPUT_SQL", "");
+  o.ogr_input.dialect = CSLFetchNameValueDef(open_options, "INPUT_DIALECT", "");
+  o.ogr_input.id_field = CSLFetchNameValueDef(open_options, "ID_FIELD", "");
+  o.ogr_input.group_by = CSLFetchNameValueDef(open_options, "GROUP_BY", "");
   if (const char* v = CSLFetchNameValue(open_options, "NUM_THREADS"))
     o.threads = gis::threads_from_string(v, "open option NUM_THREADS");
   else if (const char* g = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))

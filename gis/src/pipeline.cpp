@@ -73,11 +73,15 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, s
       CSLDestroy(list);
       if (!fs::exists(in, ec) && in.rfind("/vsi", 0) != 0) throw InputError(in + ": no such file or folder");
       std::sort(found.begin(), found.end());
+      if (found.empty() && ogr_can_read(in)) {  // parts.shp.zip: a dataset GDAL reads (issue 22), not tiles
+        files.push_back(in);
+        continue;
+      }
       if (found.empty())
         throw InputError(in + ": the zip holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb), or "
                               "is not a zip");
       files.insert(files.end(), found.begin(), found.end());
-    } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0) {
+    } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0 || looks_like_connection_string(in)) {
       files.push_back(in);
     } else {
       throw InputError(in + ": no such file or folder");

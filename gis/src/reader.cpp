@@ -73,6 +73,7 @@ const char* to_string(InputFormat f) {
     case InputFormat::Glb: return "GLB";
     case InputFormat::CityJson: return "CityJSON";
     case InputFormat::CityJsonSeq: return "CityJSONSeq";
+    case InputFormat::Ogr: return "OGR";
   }
   return "?";
 }
@@ -89,6 +90,8 @@ InputFormat detect_format(const std::string& name, std::string_view head) {
   if (ends_with(lower(name), ".city.json")) return InputFormat::CityJson;
   const InputFormat by_content = sniff(head);
   if (ext == ".xml" && by_content == InputFormat::Unknown) return InputFormat::CityGml;  // NOT_CITYGML if not
+  // A zip named .zip / .shz is no KMZ: GDAL reads zipped shapefiles (parts.shp.zip) and the like (issue 22).
+  if (by_content == InputFormat::Kmz && (ext == ".zip" || ext == ".shz")) return InputFormat::Unknown;
   return by_content;
 }
 
@@ -112,11 +115,14 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
   info = ReadInfo{};
   info.file = path;
   info.format = detect_format(path);
+  if (info.format == InputFormat::Unknown && ogr_can_read(path)) info.format = InputFormat::Ogr;
   if (info.format == InputFormat::Unknown) {
     VSIStatBufL st;
-    if (VSIStatL(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
+    if (VSIStatL(path.c_str(), &st) != 0 && !looks_like_connection_string(path))
+      throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
     throw InputError(path + ": format not recognised (CityGML .gml/.citygml/.xml, KML .kml/.kmz, glTF .gltf/.glb, "
-                            "COLLADA .dae, CityJSON .city.json/.json, CityJSONSeq .city.jsonl are read)");
+                            "COLLADA .dae, CityJSON .city.json/.json, CityJSONSeq .city.jsonl, and any vector format GDAL "
+                            "reads: none of them knows it)");
   }
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
@@ -124,12 +130,23 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     opt.on_bytes = options.on_bytes;
     read_citygml(path, opt, [&](Mesh&& m) {
       ++info.meshes;
+      if (info.source_srs != info.citygml.srs_name) info.source_srs = info.citygml.srs_name;
       on_mesh(std::move(m));
     }, problems, info.citygml);
     return;
   }
   if (info.format == InputFormat::CityJson || info.format == InputFormat::CityJsonSeq) {
     cityjson::read_into(path, options, on_mesh, problems, info);
+    return;
+  }
+  if (info.format == InputFormat::Ogr) {
+    read_ogr(path, options.ogr, [&] {
+      info.source_srs = info.ogr.source_srs;
+      info.source_axis = info.ogr.east_north ? AxisOrder::EastNorth : AxisOrder::NorthEast;
+    }, [&](Mesh&& m) {
+      ++info.meshes;
+      on_mesh(std::move(m));
+    }, problems, info.ogr);
     return;
   }
 

@@ -63,9 +63,9 @@ class Placer {
   /// `kept`: a frame to take when its srsName is the one this reading needs, and to give back at the end.
   Placer(const std::string& file, const PipelineOptions& options, const ReadContext& context,
          const bool& in_working_crs, const SourceInfo& citygml, std::optional<std::array<double, 2>> decision = {},
-         Kept* kept = nullptr)
+         Kept* kept = nullptr, const ReadInfo* read_info = nullptr)
       : file_(file), options_(options), context_(context), in_working_crs_(in_working_crs), citygml_(citygml),
-        decision_(decision), kept_(kept) {}
+        decision_(decision), kept_(kept), read_info_(read_info) {}
   ~Placer() {
     if (kept_ && frame) {
       kept_->srs = frame_srs;
@@ -86,8 +86,13 @@ class Placer {
       if (!in_working_crs_ && !frame) {
         CrsOptions crs;
         crs.target_srs = context_.working_definition;
-        crs.source_axis = options_.source_axis;
-        frame_srs = options_.s_srs.empty() ? citygml_.srs_name : options_.s_srs;  // -s_srs / -a_srs win
+        // --axis-order wins; else the order the format fixes (OGR: GDAL's data axis order), else the CRS's rule.
+        const AxisOrder format_axis = read_info_ ? read_info_->source_axis : AxisOrder::Auto;
+        crs.source_axis = options_.source_axis != AxisOrder::Auto ? options_.source_axis : format_axis;
+        // -s_srs / -a_srs win; else the CRS the format gives (OGR: the layer's), else the srsName read so far.
+        frame_srs = !options_.s_srs.empty()                             ? options_.s_srs
+                    : read_info_ && !read_info_->source_srs.empty() ? read_info_->source_srs
+                                                                    : citygml_.srs_name;
         if (kept_ && kept_->frame && kept_->srs == frame_srs)
           frame = std::move(kept_->frame);  // same srsName, options and decision: the same frame
         else
@@ -136,6 +141,7 @@ class Placer {
   const SourceInfo& citygml_;
   std::optional<std::array<double, 2>> decision_;
   Kept* kept_ = nullptr;
+  const ReadInfo* read_info_ = nullptr;  // whole-file reading: the CRS any format gives (ReadInfo::source_srs)
 };
 
 /// Footprints on the other cores while the reader reads on, each into its slot in reading order, so
@@ -255,13 +261,14 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
   read_options.lod = options.lod;
   read_options.lod_refinement = options.lod_refinement;
   read_options.origin = options.origin;
+  read_options.ogr = options.ogr_input;
   read_options.target_srs = context.working_definition;  // KML/glTF are placed by the reader, in this CRS
   bool counted_bytes = false;
   read_options.on_bytes = [&](std::uint64_t n) {
     counted_bytes = true;
     bytes.add(n);
   };
-  Placer placer(file, options, context, info.in_working_crs, info.citygml);
+  Placer placer(file, options, context, info.in_working_crs, info.citygml, {}, nullptr, &info);
   {
     FootprintMaker maker(options, true);
     try {

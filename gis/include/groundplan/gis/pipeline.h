@@ -3,6 +3,7 @@
 // The whole job, file(s) in, ground plans out (DESIGN.md stages 1-6). Shared by the OGR driver and the
 // CLI so that both routes give the same plans.
 #include <groundplan/gis/crs.h>
+#include <groundplan/gis/ogr_input.h>
 #include <groundplan/ground_plans.h>
 #include <groundplan/level_of_detail.h>
 #include <groundplan/progress.h>
@@ -28,6 +29,7 @@ struct PipelineOptions {
   std::string origin;               // "lon,lat[,alt]": where a glTF without georeference or a bare .dae sits; empty = none
   AxisOrder source_axis = AxisOrder::Auto;  // CityGML: axis order of the coordinates when a file breaks its CRS's
                                             // rule (EPSG:4979 written lon,lat): --axis-order, AXIS_ORDER=
+  OgrInputOptions ogr_input;        // OGR sources (issue 22): --input-layer, --input-where, --id-field, --group-by ...
   UnionParams union_params;
   LodParams detail;                 // level of detail for simulation (issue 9); default: the exact union
   int threads = 0;                  // threads for every stage: --threads, NUM_THREADS=, GDAL_NUM_THREADS; 0 = all cores

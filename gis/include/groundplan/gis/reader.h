@@ -9,6 +9,8 @@
 //   .dae                   COLLADA alone  meshes in the working CRS; needs ReadOptions::origin
 //   .city.json, .json      CityJSON       as CityGML: meshes as written, CRS in info.citygml.srs_name
 //   .city.jsonl, .jsonl    CityJSONSeq    (metadata.referenceSystem); .json only with "type": "CityJSON"
+//   anything else GDAL     OGR layers     meshes as written in the file's one source CRS (info.source_srs,
+//   reads as vector data                  GDAL's data axis order in info.source_axis); issue 22, ogr_input.h
 // The working CRS of self-georeferenced formats is ReadOptions::target_srs when given, else the
 // WGS 84 UTM zone of the first model's anchor; it is in info.working_crs once a mesh was placed.
 #include <groundplan/gis/citygml.h>
@@ -16,6 +18,7 @@
 #include <groundplan/gis/crs.h>
 #include <groundplan/gis/gltf.h>
 #include <groundplan/gis/kml.h>
+#include <groundplan/gis/ogr_input.h>
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
@@ -27,7 +30,7 @@
 
 namespace groundplan::gis {
 
-enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb, CityJson, CityJsonSeq };
+enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb, CityJson, CityJsonSeq, Ogr };
 const char* to_string(InputFormat format);
 
 struct ReadOptions {
@@ -37,6 +40,7 @@ struct ReadOptions {
   std::string origin;           // "lon,lat[,alt]" for glTF without georeference and bare .dae; empty = none
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
+  OgrInputOptions ogr;          // any OGR vector source: layers, filter, ids, grouping (issue 22)
   std::function<void(std::uint64_t)> on_bytes;  // CityGML: told the bytes as they are read (progress); may be empty
   CityJsonOptions cityjson;     // limits (lod and lod_refinement above win over its own)
 };
@@ -47,10 +51,15 @@ struct ReadInfo {
   bool in_working_crs = false;  // meshes arrive in working_crs (KML, glTF, COLLADA); false: as written (CityGML)
   WorkingCrs working_crs;       // valid when in_working_crs and something was placed
   std::vector<std::string> notes;  // georeference notes (UTM zone chosen ...)
+  // When !in_working_crs: the CRS the meshes are written in (CityGML srsName, an OGR layer's EPSG:n or
+  // WKT; empty = none) and, where the format fixes it, their axis order (Auto: the CRS's rule).
+  std::string source_srs;
+  AxisOrder source_axis = AxisOrder::Auto;
   SourceInfo citygml;           // CityGML; for CityJSON: srs_name (referenceSystem), envelope (geographicalExtent)
   CityJsonInfo cityjson;        // CityJSON / CityJSONSeq only
   KmlInfo kml;                  // KML/KMZ only
   GltfInfo gltf;                // glTF only
+  OgrInfo ogr;                  // OGR sources only
   std::size_t meshes = 0;       // meshes delivered
 };
 
@@ -64,7 +73,8 @@ InputFormat detect_format(const std::string& name, std::string_view head);
 /// plain .json: a tile folder holds other JSON, e.g. 3D Tiles' tileset.json).
 bool is_input_name(const std::string& name);
 
-/// Reads one file of any supported format. `info.format` and `info.in_working_crs` are set before
+/// Reads one file of any supported format (a file the city formats do not recognise goes to GDAL's
+/// vector drivers: identified by content, so connection strings and /vsi paths work too). `info.format` and `info.in_working_crs` are set before
 /// the first mesh is delivered. Per-building defects are Problems. Throws InputError naming the file
 /// when it cannot be read at all, when its format is unknown, or when a glTF / COLLADA file has no
 /// georeference and no origin was given ("pass --origin lon,lat,alt"); InvalidArgument for a bad
