@@ -16,7 +16,9 @@ LAYERS = ["ground_plans", "footprints", "problems", "plan_members"]
 def real_inputs():
     files = sorted(p for root in (SAMPLES, SHARED_DATA) for p in root.rglob("*")
                    if p.suffix in (".gml", ".citygml") and p.is_file())
-    folders = [SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", SHARED_DATA / "citygml2-plateau-japan-lod1"]
+    # Folders: read side by side (CityJSON and CityJSONSeq files are read whole, but side by side too).
+    folders = [SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", SHARED_DATA / "citygml2-plateau-japan-lod1",
+               SHARED_DATA / "cityjson-3dbag-cjseq"]
     return files + folders
 
 
