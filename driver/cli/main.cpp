@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <sys/resource.h>
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
@@ -253,14 +252,6 @@ using clock = std::chrono::steady_clock;
 
 double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
 
-/// CPU time of the process, all threads (getrusage): compared with the wall time it shows idle or spinning cores.
-double cpu_seconds() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
 bool write_stats(const std::string& path, const PipelineResult& result, double write_s, double total_s, double cpu_s,
                  const nlohmann::json* verify, const groundplan::LodParams& lod) {
   nlohmann::json j;
@@ -411,7 +402,7 @@ int run(int argc, char** argv) {
     options.threads = groundplan::gis::threads_from_string(v, "GDAL_NUM_THREADS");
   options.read_chunk_bytes = read_chunk_bytes;
 
-  const double cpu0 = cpu_seconds();
+  const double cpu0 = groundplan::gis::process_cpu_seconds();
   const auto t0 = clock::now();
   groundplan::Progress progress;
   if (ogr.progress && !ogr.quiet)
@@ -430,7 +421,7 @@ int run(int argc, char** argv) {
                      ? "no building found"
                      : (std::to_string(result.buildings_read) + " buildings read, none gave a footprint").c_str());
     if (!stats_path.empty())
-      write_stats(stats_path, result, 0, seconds_since(t0), cpu_seconds() - cpu0, nullptr, options.detail);
+      write_stats(stats_path, result, 0, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0, nullptr, options.detail);
     return 1;
   }
 
@@ -465,7 +456,7 @@ int run(int argc, char** argv) {
   }
   GDALClose(src_h);
   const double write_s = seconds_since(t_write);
-  const double total_s = seconds_since(t0), cpu_s = cpu_seconds() - cpu0;  // before --verify and --preview
+  const double total_s = seconds_since(t0), cpu_s = groundplan::gis::process_cpu_seconds() - cpu0;  // before --verify and --preview
   if (!write_ok) {
     std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr.dst.c_str(),
                  usage_error ? " (bad ogr2ogr options)" : "");

@@ -160,13 +160,6 @@ bool raster_mode_from_string(const std::string& s) {
 
 namespace {
 
-double cpu_seconds() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
 std::uint64_t total_bytes(const std::vector<std::string>& files) {
   std::uint64_t total = 0;
   for (const std::string& f : files) {
@@ -211,7 +204,7 @@ void merge_file(detail::FileRead&& r, const std::string& file, detail::ReadConte
 }
 
 PipelineResult run(const PipelineOptions& options, const Progress& progress, std::size_t threads) {
-  const double cpu0 = cpu_seconds();
+  const double cpu0 = process_cpu_seconds();
   PipelineResult result;
   const std::vector<std::string> files = expand_inputs(options.inputs, result.problems);
   result.reading.files = files.size();
@@ -268,12 +261,19 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   result.timings.lod_s = ls.snap_s + ls.close_s + ls.raster_s + ls.simplify_s + ls.filter_s;
   result.timings.blocks_s = union_stats.blocks_s;
   result.timings.union_s = seconds_since(t_union) - union_stats.blocks_s - result.timings.lod_s;
-  result.timings.cpu_s = cpu_seconds() - cpu0;
+  result.timings.cpu_s = process_cpu_seconds() - cpu0;
   progress.report(1.0, "done");
   return result;
 }
 
 }  // namespace
+
+double process_cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
 
 std::size_t thread_count(int requested) {
   if (requested > 0) return static_cast<std::size_t>(requested);

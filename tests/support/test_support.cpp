@@ -5,10 +5,50 @@
 
 #include <groundplan/gis/geos_reference.h>
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
 namespace groundplan::test {
 
 std::string shared_data(const std::string& relative) { return std::string(GROUNDPLAN_SHARED_DATA_DIR) + "/" + relative; }
 std::string sample_data(const std::string& relative) { return std::string(GROUNDPLAN_SAMPLE_DATA_DIR) + "/" + relative; }
+
+TempDir::TempDir(const std::string& prefix) {
+  static int n = 0;
+  path = std::filesystem::temp_directory_path() /
+         (prefix + "_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
+  std::filesystem::create_directories(path);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path, ec);
+}
+
+std::string TempDir::file(const std::string& rel, const std::string& content) const {
+  const std::filesystem::path p = path / rel;
+  std::filesystem::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << content;
+  return p.string();
+}
+
+std::vector<std::string> plan_keys(const std::vector<GroundPlan>& plans) {
+  std::vector<std::string> out;
+  for (const GroundPlan& p : plans) {
+    std::string s;
+    char buf[64];
+    for (const Point2& q : p.polygon.outer) {
+      std::snprintf(buf, sizeof buf, "%.6f %.6f,", q.x, q.y);
+      s += buf;
+    }
+    out.push_back(s + "|" + std::to_string(p.polygon.holes.size()));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
 
 std::vector<Footprint> footprints_from_wkt(const std::vector<std::string>& wkts) {
   std::vector<Footprint> out;

@@ -19,29 +19,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_support.h"
+
 namespace groundplan::gis {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int n = 0;
-    path = fs::temp_directory_path() / ("groundplan_gltf_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& rel, const std::string& content) const {
-    const fs::path p = path / rel;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << content;
-    return p.string();
-  }
-};
 
 std::string base64(const std::string& in) {
   static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -131,7 +115,7 @@ std::array<double, 4> centre(const Mesh& m) {
 }
 
 TEST(Gltf, CubeWithOriginLandsOnProjsAnchorWithin1cm) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_gltf_test");
   const double lon = 13.4050, lat = 52.5200;  // Berlin, UTM 33N
   ReadOptions opt;
   opt.origin = "13.4050,52.5200,34";
@@ -152,7 +136,7 @@ TEST(Gltf, CubeWithOriginLandsOnProjsAnchorWithin1cm) {
 }
 
 TEST(Gltf, NoGeoreferenceAndNoOriginIsAClearError) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_gltf_test");
   const std::string path = tmp.file("local.gltf", cube_json(data_uri(cube_buffer())));
   try {
     read(path);
@@ -164,7 +148,7 @@ TEST(Gltf, NoGeoreferenceAndNoOriginIsAClearError) {
 }
 
 TEST(Gltf, CesiumRtcAndEcefRootNodeAreGeoreferences) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_gltf_test");
   const double lon = -105.2728, lat = 40.0100;
   const auto c = ecef(lon, lat, 1600);
   const auto anchor = proj_forward("EPSG:32613", lon, lat);
@@ -192,7 +176,7 @@ TEST(Gltf, CesiumRtcAndEcefRootNodeAreGeoreferences) {
 }
 
 TEST(GltfHostile, OutOfRangeAccessorsIndicesAndBuffersAreProblemsOrErrors) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_gltf_test");
   ReadOptions opt;
   opt.origin = "13.4,52.5";
   // POSITION count 80 over a 96-byte view; indices count 360 over a 72-byte view.

@@ -27,6 +27,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_support.h"
+
 namespace groundplan::gis {
 namespace {
 
@@ -35,30 +37,8 @@ namespace fs = std::filesystem;
 std::string shared(const std::string& rel) { return std::string(GROUNDPLAN_SHARED_DATA_DIR) + "/" + rel; }
 
 // ---------------------------------------------------------------------------------------------------
-// Helpers: temp folder, stored zip writer, PROJ oracle.
+// Helpers: stored zip writer, PROJ oracle (the temp folder: test::TempDir).
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("groundplan_kml_test_" + std::to_string(::getpid()) + "_" +
-                                        std::to_string(counter()++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  static int& counter() {
-    static int n = 0;
-    return n;
-  }
-  std::string file(const std::string& rel, const std::string& content) const {
-    const fs::path p = path / rel;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << content;
-    return p.string();
-  }
-};
 
 std::uint32_t crc32(const std::string& data) {
   static const auto table = [] {
@@ -320,7 +300,7 @@ TEST(KmlRealData, PipelineEndToEndOnKmzAndKmlFolders) {
 // Small files made here.
 
 TEST(KmlPlacement, UnitCubeInKmzLandsOnProjsAnchorWithin1cm) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_kml_test");
   const double lon = 8.4037, lat = 49.0069;  // Karlsruhe, 0.6° west of UTM 32N's central meridian
   const std::string kmz = tmp.file("cube.kmz", make_zip({{"doc.kml", model_kml(lon, lat, "models/cube.dae")},
                                                          {"models/cube.dae", cube_dae()}}));
@@ -358,7 +338,7 @@ TEST(KmlPlacement, UnitCubeInKmzLandsOnProjsAnchorWithin1cm) {
 }
 
 TEST(KmlPlacement, Heading90TurnsNorthToEast) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_kml_test");
   // A 2 m (x) by 1 m (y) box with a corner at the anchor; on UTM 32N's central meridian (no grid
   // convergence). Heading 90 is clockwise: model x (east) goes south, model y (north) goes east.
   std::string dae = cube_dae();
@@ -460,7 +440,7 @@ TEST(Collada, NodeTransformsInstanceNodesAndPrimitives) {
 }
 
 TEST(Kml, OrderCommentsNamespacesMultiGeometryAndIds) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_kml_test");
   tmp.file("c.dae", cube_dae());
   const std::string kml = tmp.file("k.kml", R"(<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Folder><Folder>
 <Placemark><name>two</name><LookAt><longitude>1</longitude><latitude>1</latitude><heading>45</heading></LookAt>
@@ -511,7 +491,7 @@ TEST(Kml, HrefResolution) {
 // Hostile input: a Problem or an InputError, bounded time, nothing outside the input opened.
 
 TEST(KmlHostile, EscapingAbsoluteAndRemoteLinksAreProblems) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_kml_test");
   const std::string doc = R"(<kml xmlns="http://www.opengis.net/kml/2.2"><Document>
 <Placemark id="escape"><Model><Location><longitude>8</longitude><latitude>49</latitude></Location>
  <Link><href>../../etc/passwd</href></Link></Model></Placemark>
@@ -540,7 +520,7 @@ TEST(KmlHostile, EscapingAbsoluteAndRemoteLinksAreProblems) {
 }
 
 TEST(KmlHostile, ZipBombsAreRefusedInBoundedTime) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_kml_test");
   const auto t0 = std::chrono::steady_clock::now();
   // A .dae whose stated size is 2 GiB (forged central directory): refused before reading.
   const std::string forged = tmp.file("forged.kmz", make_zip({{"doc.kml", model_kml(8, 49, "m.dae")},
@@ -578,7 +558,7 @@ TEST(KmlHostile, ZipBombsAreRefusedInBoundedTime) {
 }
 
 TEST(KmlHostile, NotAZipNotXmlAndEntities) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_kml_test");
   try {
     read(tmp.file("fake.kmz", "this is not a zip archive at all"));
     FAIL() << "no exception";

@@ -17,29 +17,13 @@
 
 #include "test_config.h"
 
+#include "test_support.h"
+
 namespace groundplan::gis {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int n = 0;
-    path = fs::temp_directory_path() / ("groundplan_netlink_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& rel, const std::string& content) const {
-    const fs::path p = path / rel;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << content;
-    return p.string();
-  }
-};
 
 const fs::path kKorea = fs::path(GROUNDPLAN_SHARED_DATA_DIR) / "kml-collada-korea-mago" / "sample-kml";
 
@@ -69,24 +53,10 @@ Read read(const std::string& path, const KmlOptions& options = {}) {
   return r;
 }
 
-std::vector<std::string> plan_keys(const PipelineResult& r) {
-  std::vector<std::string> out;
-  for (const GroundPlan& p : r.plans) {
-    std::string s;
-    char buf[64];
-    for (const Point2& q : p.polygon.outer) {
-      std::snprintf(buf, sizeof buf, "%.6f %.6f,", q.x, q.y);
-      s += buf;
-    }
-    out.push_back(s + "|" + std::to_string(p.polygon.holes.size()));
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 /// Tiles/<i>/0/ holds one Korean sample building (its .kml and .dae); master.kml links them as
 /// 3DCityDB writes them, with backslashes, through an intermediate tile index.
-std::vector<std::string> make_export(const TempDir& tmp) {
+std::vector<std::string> make_export(const test::TempDir& tmp) {
   std::vector<std::string> tiles;
   std::string index;
   int i = 0;
@@ -105,7 +75,7 @@ std::vector<std::string> make_export(const TempDir& tmp) {
 }
 
 TEST(KmlNetworkLink, CityDbExportGivesTheSamePlansAsItsTiles) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_netlink_test");
   const std::vector<std::string> tiles = make_export(tmp);
   const Read r = read((tmp.path / "master.kml").string());
   EXPECT_EQ(r.meshes, 3u);
@@ -121,12 +91,12 @@ TEST(KmlNetworkLink, CityDbExportGivesTheSamePlansAsItsTiles) {
   EXPECT_EQ(via_links.buildings_read, 3u);
   EXPECT_EQ(via_links.footprints.size(), listed.footprints.size());
   ASSERT_FALSE(listed.plans.empty());
-  EXPECT_EQ(plan_keys(via_links), plan_keys(listed));
+  EXPECT_EQ(test::plan_keys(via_links.plans), test::plan_keys(listed.plans));
   EXPECT_EQ(via_links.crs_name, listed.crs_name);
 }
 
 TEST(KmlNetworkLink, HostileLinksAreBoundedAndReported) {
-  TempDir tmp;
+  test::TempDir tmp("groundplan_netlink_test");
   make_export(tmp);
   tmp.file("outside.kml", kml_doc(""));
   const std::string body = network_link("..\\outside.kml") + network_link("../../etc/passwd.kml") +

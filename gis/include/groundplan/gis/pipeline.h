@@ -81,6 +81,10 @@ struct PipelineResult {
 /// when `progress` asks to stop. A bad building is a Problem, not an exception.
 PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
 
+/// CPU time of this process so far, all threads (getrusage), in seconds: set beside a wall time, it shows
+/// idle or spinning cores (--stats "timings_s"."cpu").
+double process_cpu_seconds();
+
 /// Threads a run uses: `requested` when > 0, else all cores (TBB's default concurrency).
 std::size_t thread_count(int requested);
 
