@@ -224,7 +224,7 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   progress.report(0, "reading");
   std::size_t fi = 0;
   for (; fi < files.size() && context.working_definition.empty(); ++fi)
-    merge_file(detail::read_file(files[fi], options, context, threads, bytes), files[fi], context, result,
+    merge_file(detail::read_file(files[fi], options, context, threads, 0, bytes), files[fi], context, result,
                files_failed, first_failure);
   if (fi < files.size()) {
     // Largest first, so that a big file does not start last; at most one task a thread in flight, so
@@ -237,11 +237,13 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
       if (VSIStatL(files[fi + k].c_str(), &st) == 0) size[fi + k] = static_cast<std::uint64_t>(st.st_size);
     }
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
+    std::uint64_t shared = 0;  // the bytes these files share the threads with
+    for (std::size_t f : order) shared += size[f];
     std::vector<detail::FileRead> reads(files.size());
     const detail::ReadContext fixed = context;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k)
-        reads[order[k]] = detail::read_file(files[order[k]], options, fixed, threads, bytes);
+        reads[order[k]] = detail::read_file(files[order[k]], options, fixed, threads, shared, bytes);
     }, tbb::simple_partitioner());
     for (; fi < files.size(); ++fi)
       merge_file(std::move(reads[fi]), files[fi], context, result, files_failed, first_failure);

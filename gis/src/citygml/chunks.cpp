@@ -18,7 +18,8 @@
 namespace groundplan::gis {
 namespace {
 
-constexpr std::uint64_t kWindow = 1 << 20;          // bytes read around a cut
+constexpr std::uint64_t kWindow = 64u << 10;        // bytes read at a time around a cut
+constexpr std::uint64_t kFirstHead = 64u << 10;     // the head is read in reads doubling from this
 constexpr std::uint64_t kMaxHead = 16u << 20;       // the first member must start within this
 constexpr std::uint64_t kMaxMemberSearch = 64u << 20;  // past this without a member start, no more cuts
 
@@ -85,19 +86,23 @@ struct VsiFile {
   ~VsiFile() {
     if (f) VSIFCloseL(f);
   }
-  std::string read(std::uint64_t at, std::uint64_t n) const {
-    std::string out(static_cast<std::size_t>(n), '\0');
+  /// Up to `n` bytes at `at`, into one buffer reused from read to read (planning a file of many cuts
+  /// reads a few KiB per cut, not a fresh zero-filled buffer each time).
+  std::string_view read(std::uint64_t at, std::uint64_t n) {
+    if (buf_.size() < n) buf_.resize(static_cast<std::size_t>(n));
     if (VSIFSeekL(f, at, SEEK_SET) != 0) return {};
-    out.resize(VSIFReadL(out.data(), 1, out.size(), f));
-    return out;
+    return {buf_.data(), VSIFReadL(buf_.data(), 1, static_cast<std::size_t>(n), f)};
   }
+
+ private:
+  std::string buf_;
 };
 
 /// The first member start at or after `from`, or `size` when there is none within kMaxMemberSearch.
-std::uint64_t next_member_start(const VsiFile& file, std::uint64_t from, std::uint64_t size) {
+std::uint64_t next_member_start(VsiFile& file, std::uint64_t from, std::uint64_t size) {
   constexpr std::uint64_t kOverlap = 256;  // a tag cut by a window's end is found in the next window
   for (std::uint64_t at = from; at < size && at - from < kMaxMemberSearch; at += kWindow) {
-    const std::string buf = file.read(at, std::min(kWindow + kOverlap, size - at));
+    const std::string_view buf = file.read(at, std::min(kWindow + kOverlap, size - at));
     const std::size_t p = find_member_start(buf);
     if (p != std::string_view::npos) return at + p;
     if (buf.size() <= kOverlap) break;
@@ -121,15 +126,21 @@ CityGmlChunkPlan plan_citygml_chunks(const std::string& path, std::uint64_t chun
   file.f = VSIFOpenL(path.c_str(), "rb");
   if (!file.f) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
 
-  const std::string head = file.read(0, std::min(kMaxHead, plan.file_bytes));
-  const std::size_t first = find_member_start(head);
+  // The head, in reads doubling in size: a file's first member usually starts within a few KiB.
+  std::string_view head;
+  std::size_t first = std::string_view::npos;
+  for (std::uint64_t n = std::min(kFirstHead, plan.file_bytes);; n = std::min(2 * n, std::min(kMaxHead, plan.file_bytes))) {
+    head = file.read(0, n);
+    first = find_member_start(head);
+    if (first != std::string_view::npos || n >= std::min(kMaxHead, plan.file_bytes)) break;
+  }
   if (first == std::string_view::npos) {
     plan.why_not = "no cityObjectMember or featureMember in the first 16 MiB";
     return plan;
   }
-  const std::string root = root_name(std::string_view(head).substr(0, first), plan.why_not);
+  const std::string root = root_name(head.substr(0, first), plan.why_not);
   if (root.empty()) return plan;
-  plan.head = head.substr(0, first);
+  plan.head = std::string(head.substr(0, first));
   plan.tail = "</" + root + ">";
 
   std::uint64_t begin = first;

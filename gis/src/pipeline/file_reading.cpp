@@ -384,10 +384,10 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
   return out;
 }
 
-/// Bytes per chunk for a file of `size` read with `threads` threads: about four chunks a thread,
+/// Bytes per chunk when `shared` bytes are read with `threads` threads: about four chunks a thread,
 /// 2-64 MiB each (a chunk re-reads the file's head, and a thread should not wait on one huge chunk).
-std::uint64_t auto_chunk_bytes(std::uint64_t size, std::size_t threads) {
-  const std::uint64_t per = size / (4 * std::max<std::size_t>(threads, 1));
+std::uint64_t auto_chunk_bytes(std::uint64_t shared, std::size_t threads) {
+  const std::uint64_t per = shared / (4 * std::max<std::size_t>(threads, 1));
   return std::clamp<std::uint64_t>(per, std::uint64_t{2} << 20, std::uint64_t{64} << 20);
 }
 
@@ -403,7 +403,7 @@ void ByteProgress::add(std::uint64_t n) {
 }
 
 FileRead read_file(const std::string& file, const PipelineOptions& options, const ReadContext& context,
-                   std::size_t threads, ByteProgress& bytes) {
+                   std::size_t threads, std::uint64_t shared_bytes, ByteProgress& bytes) {
   std::string whole_reason;
   const bool may_cut = options.read_chunk_bytes >= 0 && (options.read_chunk_bytes > 0 || threads > 1);
   if (may_cut && detect_format(file) == InputFormat::CityGml) {
@@ -411,7 +411,7 @@ FileRead read_file(const std::string& file, const PipelineOptions& options, cons
     if (VSIStatL(file.c_str(), &st) == 0) {
       const auto size = static_cast<std::uint64_t>(st.st_size);
       const std::uint64_t chunk = options.read_chunk_bytes > 0 ? static_cast<std::uint64_t>(options.read_chunk_bytes)
-                                                               : auto_chunk_bytes(size, threads);
+                                                               : auto_chunk_bytes(std::max(size, shared_bytes), threads);
       if (size >= 2 * chunk) {
         try {
           const CityGmlChunkPlan plan = plan_citygml_chunks(file, chunk, std::min<std::uint64_t>(chunk, 1 << 20));

@@ -58,9 +58,11 @@ class ByteProgress {
 };
 
 /// Reads one file (a CityGML file of at least two chunks in chunks side by side, unless
-/// options.read_chunk_bytes < 0). Never throws for the file's content (a failure is in FileRead);
-/// throws Cancelled.
+/// options.read_chunk_bytes < 0). `shared_bytes`: the bytes read side by side with this file on the
+/// `threads` threads (the file's own size when it is read alone, every file left when files are read
+/// side by side): automatic chunks are sized from it, so that a folder of many tiles is not cut finer
+/// than its threads need. Never throws for the file's content (a failure is in FileRead); throws Cancelled.
 FileRead read_file(const std::string& file, const PipelineOptions& options, const ReadContext& context,
-                   std::size_t threads, ByteProgress& bytes);
+                   std::size_t threads, std::uint64_t shared_bytes, ByteProgress& bytes);
 
 }  // namespace groundplan::gis::detail

@@ -148,6 +148,37 @@ TEST(ChunkedCityGml, ACutInsideAMemberMakesTheChunkFailNotReadOtherwise) {
   EXPECT_EQ(failed, 4u);
 }
 
+TEST(ChunkedCityGml, CutsAreFoundPastLongHeadsAndAcrossTheReadWindows) {
+  // The planner reads the head, and around each cut, a few KiB at a time: a first member far into the
+  // file (a 200 KiB envelope comment) and members far apart, with their start tags falling across every
+  // byte offset of the planner's read windows, must still give a cut at every member.
+  const std::string head =
+      "<?xml version=\"1.0\"?>\n<core:CityModel xmlns:core=\"http://www.opengis.net/citygml/2.0\" "
+      "xmlns:bldg=\"http://www.opengis.net/citygml/building/2.0\" xmlns:gml=\"http://www.opengis.net/gml\">\n<!--" +
+      std::string(200 << 10, '.') + "-->\n";
+  std::string doc = head;
+  std::vector<std::uint64_t> starts;
+  for (int i = 0; i < 100; ++i) {
+    starts.push_back(doc.size());
+    // Members of 64 KiB - 200 + 7i bytes: the next start tag, searched from just after a cut, walks
+    // across the ends of the planner's 64 KiB windows (with and without their overlap).
+    doc += "<core:cityObjectMember><bldg:Building gml:id=\"b" + std::to_string(i) + "\"><!--" +
+           std::string((64u << 10) - 200u + 7u * static_cast<unsigned>(i), ' ') +
+           "--></bldg:Building></core:cityObjectMember>\n";
+  }
+  doc += "</core:CityModel>\n";
+  const std::string path = "/vsimem/chunks_long_head.gml";
+  VSILFILE* f = VSIFileFromMemBuffer(path.c_str(), reinterpret_cast<GByte*>(doc.data()), doc.size(), FALSE);
+  VSIFCloseL(f);
+  const gis::CityGmlChunkPlan plan = gis::plan_citygml_chunks(path, 1, 1);
+  VSIUnlink(path.c_str());
+  ASSERT_TRUE(plan.why_not.empty()) << plan.why_not;
+  EXPECT_EQ(plan.head.size(), head.size());
+  std::vector<std::uint64_t> cuts;
+  for (const auto& r : plan.ranges) cuts.push_back(r.first);
+  EXPECT_EQ(cuts, starts);
+}
+
 // --- the whole pipeline -----------------------------------------------------------------------
 
 void expect_same(const gis::PipelineResult& a, const gis::PipelineResult& b) {
