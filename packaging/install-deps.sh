@@ -17,6 +17,8 @@ packages=(
   libsimdjson-dev
   # CLI parsing, JSON (--stats), thread pool
   libcli11-dev nlohmann-json3-dev libtbb-dev
+  # GeoPackage spatial index packed by the CLI (GDAL's own SQLite)
+  libsqlite3-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev python3-pytest
   # the GeoPandas/Shapely baseline of the OGR-input benchmark (issue 22, tests/bench/ogr_input_bench.sh)

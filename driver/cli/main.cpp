@@ -4,6 +4,7 @@
 // ogr2ogr option behaves as users know it.
 #include "ogr_groundplan.h"
 #include "open_options.h"
+#include "gpkg_rtree.h"
 #include "preview.h"
 
 #include <groundplan/error.h>
@@ -13,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <gdal_utils.h>
+#include <gdal_version.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -135,6 +137,24 @@ bool writes_dbf(const Ogr2ogrArgs& ogr) {
   return ext == ".shp" || ext == ".dbf";
 }
 
+/// True when the CLI builds the GeoPackage's spatial index itself (gpkg_rtree.h): a new local .gpkg written
+/// by GDAL < 3.7 (later versions build theirs in a background thread), the user having said nothing of
+/// SPATIAL_INDEX (-lco SPATIAL_INDEX=YES asks for GDAL's own) and not adding to an existing file.
+bool packs_gpkg_index(const Ogr2ogrArgs& ogr) {
+  if (GDAL_VERSION_NUM >= 3070000) return false;
+  const std::string ext = lower(std::filesystem::path(ogr.dst).extension().string());
+  if (!(ogr.format.empty() ? ext == ".gpkg" : lower(ogr.format) == "gpkg")) return false;
+  std::error_code ec;
+  if (ogr.dst.rfind("/vsi", 0) == 0 || std::filesystem::exists(ogr.dst, ec)) return false;
+  for (std::size_t i = 0; i < ogr.options.size(); ++i) {
+    const std::string o = lower(ogr.options[i]);
+    if (o == "-append" || o == "-update" || o == "-upsert" || o == "-addfields") return false;
+    if (o == "-lco" && i + 1 < ogr.options.size() && lower(ogr.options[i + 1]).rfind("spatial_index=", 0) == 0)
+      return false;
+  }
+  return true;
+}
+
 /// Runs GDAL's ogr2ogr on `src` with `args`; false (GDAL has printed why) on failure.
 bool vector_translate(const std::string& dst, GDALDatasetH src, const std::vector<std::string>& args, bool progress,
                       int* usage_error) {
@@ -252,8 +272,9 @@ using clock = std::chrono::steady_clock;
 
 double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
 
-bool write_stats(const std::string& path, const PipelineResult& result, double write_s, double total_s, double cpu_s,
-                 const nlohmann::json* verify, const groundplan::LodParams& lod) {
+bool write_stats(const std::string& path, const PipelineResult& result, double write_s, double index_s, double total_s,
+                 double cpu_s, const nlohmann::json* verify, const groundplan::LodParams& lod,
+                 const groundplan::cli::RtreeBuild* index = nullptr) {
   nlohmann::json j;
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                  {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
@@ -262,13 +283,16 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   j["timings_s"] = {{"read", result.timings.read_s},     {"footprints", result.timings.footprints_s},
                     {"blocks", result.timings.blocks_s}, {"union", result.timings.union_s},
                     {"level_of_detail", result.timings.lod_s}, {"write", write_s},
-                    {"total", total_s},                  {"cpu", cpu_s}};
+                    {"spatial_index", index_s},          {"total", total_s}, {"cpu", cpu_s}};
   const groundplan::gis::ReadStats& rs = result.reading;
   nlohmann::json whole = nlohmann::json::array();
   for (const auto& [file, why] : rs.read_whole) whole.push_back({{"file", file}, {"why", why}});
   j["reading"] = {{"threads", rs.threads}, {"files", rs.files},       {"bytes", rs.bytes},
                   {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole}};
   j["raster_backend"] = result.raster_backend;
+  if (index)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
+    j["spatial_index"] = {{"tables", index->tables}, {"entries", index->entries}, {"read_s", index->read_s},
+                          {"write_s", index->write_s}, {"commit_s", index->commit_s}, {"error", index->error}};
   if (lod.any()) j["level_of_detail"] = lod_json(lod, result.lod_stats);
   if (verify) j["verify"] = *verify;
   std::ofstream f(path);
@@ -421,7 +445,8 @@ int run(int argc, char** argv) {
                      ? "no building found"
                      : (std::to_string(result.buildings_read) + " buildings read, none gave a footprint").c_str());
     if (!stats_path.empty())
-      write_stats(stats_path, result, 0, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0, nullptr, options.detail);
+      write_stats(stats_path, result, 0, 0, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0, nullptr,
+                  options.detail);
     return 1;
   }
 
@@ -431,10 +456,37 @@ int run(int argc, char** argv) {
                                                              result_ptr, dbf ? 254 : 0, options.threads);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
   std::vector<std::string> vt_args = ogr.options;
+  const bool own_index = packs_gpkg_index(ogr);
+  if (own_index) vt_args.insert(vt_args.end(), {"-lco", "SPATIAL_INDEX=NO"});
   if (!ogr.layer_named) vt_args.push_back("ground_plans");
   const auto t_write = clock::now();
   int usage_error = FALSE;
   bool write_ok = vector_translate(ogr.dst, src_h, vt_args, ogr.progress && !ogr.quiet, &usage_error);
+  double index_s = 0;
+  groundplan::cli::RtreeBuild built;
+  if (write_ok && own_index) {
+    const auto t_index = clock::now();
+    built = groundplan::cli::build_gpkg_rtrees(
+        ogr.dst, {}, static_cast<int>(groundplan::gis::thread_count(options.threads)));
+    if (!built.error.empty()) {
+      // Never leave a GeoPackage without the index a GDAL user expects: GDAL's own way, slower.
+      std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL builds it instead\n",
+                   built.error.c_str());
+      GDALDatasetH out = GDALOpenEx(ogr.dst.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+      for (const std::string& table : groundplan::cli::gpkg_unindexed_tables(ogr.dst)) {
+        OGRLayerH layer = out ? GDALDatasetGetLayerByName(out, table.c_str()) : nullptr;
+        const char* geom = layer ? OGR_L_GetGeometryColumn(layer) : nullptr;
+        if (!geom) continue;
+        const std::string sql = "SELECT CreateSpatialIndex('" + table + "', '" + geom + "')";
+        if (OGRLayerH r = GDALDatasetExecuteSQL(out, sql.c_str(), nullptr, nullptr)) GDALDatasetReleaseResultSet(out, r);
+      }
+      CPLErrorReset();
+      if (out) GDALClose(out);
+      if (CPLGetLastErrorType() >= CE_Failure || !groundplan::cli::gpkg_unindexed_tables(ogr.dst).empty())
+        std::fprintf(stderr, "groundplan: warning: %s has no spatial index\n", ogr.dst.c_str());
+    }
+    index_s = seconds_since(t_index);
+  }
 
   // DBF fields hold 254 characters: cut lists are marked "...(+N)" and the full lists go beside them.
   std::string members_note;
@@ -508,8 +560,8 @@ int run(int argc, char** argv) {
                    {"holes_geos_artifacts", c.holes_geos_artifacts}};
     if (!ok) rc = 3;
   }
-  if (!stats_path.empty() && !write_stats(stats_path, result, write_s, total_s, cpu_s, verify ? &verify_json : nullptr,
-                                          options.detail))
+  if (!stats_path.empty() && !write_stats(stats_path, result, write_s, index_s, total_s, cpu_s, verify ? &verify_json : nullptr,
+                                          options.detail, own_index && write_ok ? &built : nullptr))
     return 1;
   return rc;
 }

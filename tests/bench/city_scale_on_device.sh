@@ -23,10 +23,11 @@ import json, sys
 name, stats, tm = sys.argv[1:4]
 d = json.load(open(stats)); t = d["timings_s"]; r = d.get("reading", {})
 wall, user, sys_, rss = open(tm).read().split()[-4:]
-print("%-22s wall %6.2f s | read %6.2f fp %5.2f blocks %5.2f union %5.2f write %5.2f | cpu %6.1f s | rss %5.0f MiB | "
-      "threads %s chunked %s/%s files, %s chunks | plans %s" % (name, float(wall), t["read"], t["footprints"], t["blocks"],
-      t["union"], t["write"], float(user) + float(sys_), int(rss) / 1024, r.get("threads"), r.get("files_chunked"),
-      r.get("files"), r.get("chunks"), d["counts"]["ground_plans"]))
+print("%-22s wall %6.2f s | read %6.2f fp %5.2f blocks %5.2f union %5.2f write %5.2f (index %4.2f) | cpu %6.1f s | "
+      "rss %5.0f MiB | threads %s chunked %s/%s files, %s chunks | plans %s" % (name, float(wall), t["read"],
+      t["footprints"], t["blocks"], t["union"], t["write"], t.get("spatial_index", 0), float(user) + float(sys_),
+      int(rss) / 1024, r.get("threads"), r.get("files_chunked"), r.get("files"), r.get("chunks"),
+      d["counts"]["ground_plans"]))
 PY
 }
 gp() {  # NAME ARGS... : one run, its line
@@ -53,6 +54,23 @@ for i in 1 2 3; do gp "file_all_$i" -f GPKG "$W/file_all_$i.gpkg" "$W/city.gml";
 for i in 1 2 3; do gp "tiles_all_$i" -f GPKG "$W/tiles_all_$i.gpkg" "$W/tiles"; done
 gp file_t1 -f GPKG "$W/file_t1.gpkg" "$W/city.gml" --threads 1
 gp tiles_t1 -f GPKG "$W/tiles_t1.gpkg" "$W/tiles" --threads 1
+
+echo "== GeoPackage spatial index: packed by us (above) against GDAL's own (-lco SPATIAL_INDEX=YES), and none"
+for i in 1 2 3; do gp "file_gdalidx_$i" -f GPKG "$W/file_gdalidx_$i.gpkg" "$W/city.gml" -lco SPATIAL_INDEX=YES; done
+gp file_noidx -f GPKG "$W/file_noidx.gpkg" "$W/city.gml" -lco SPATIAL_INDEX=NO
+python3 - "$W/file_all_1.gpkg" "$W/file_gdalidx_1.gpkg" <<'PY'
+import sqlite3, sys
+a, b = (sqlite3.connect(f) for f in sys.argv[1:3])
+q = "SELECT id, minx, maxx, miny, maxy FROM rtree_ground_plans_geom ORDER BY id"
+schema = "SELECT type, name, tbl_name, sql FROM sqlite_master ORDER BY type, name"
+print("index entries equal:", list(a.execute(q)) == list(b.execute(q)), "| schema equal:",
+      list(a.execute(schema)) == list(b.execute(schema)), "| rtreecheck:",
+      a.execute("SELECT rtreecheck('rtree_ground_plans_geom')").fetchone()[0])
+PY
+if [ -e $G/lib/libtbbmalloc_proxy.so.2 ]; then
+  echo "== TBB's allocator (LD_PRELOAD libtbbmalloc_proxy) against glibc's, one file, all cores"
+  for i in 1 2 3; do LD_PRELOAD=$G/lib/libtbbmalloc_proxy.so.2 gp "file_tbbmalloc_$i" -f GPKG "$W/file_tbbmalloc_$i.gpkg" "$W/city.gml"; done
+fi
 
 echo "== the writer against ogr2ogr copying the same features (GPKG -> GPKG)"
 if [ -x $G/bin/ogr2ogr ]; then

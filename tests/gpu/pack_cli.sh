@@ -20,6 +20,8 @@ for b in "${bins[@]}"; do ldd "$b"; done | awk '$3 ~ /^\// {print $3}' | sort -u
 done
 cp -r /usr/share/gdal "$T/gp/share/gdal"
 mkdir -p "$T/gp/share/proj" && cp /usr/share/proj/proj.db "$T/gp/share/proj/"
+# PACK_EXTRA_LIBS: other libraries to pack (libtbbmalloc_proxy.so.2, to try TBB's allocator by LD_PRELOAD).
+for l in ${PACK_EXTRA_LIBS:-}; do cp -L "$l" "$T/gp/lib/"; done
 for f in "$@"; do cp -r "$f" "$T/gp/data/"; done
 du -sh "$T/gp"
 tar -C "$T" -cf - gp | xz -T2 -6 > "$OUTF"
