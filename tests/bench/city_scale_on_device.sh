@@ -14,7 +14,7 @@ W=/tmp/gp-city; rm -rf "$W"; mkdir -p "$W"
 xz -dc "$BUNDLE" | tar -C "$W" -xf - || { echo "cannot unpack $BUNDLE"; exit 1; }
 G=$W/gp
 export LD_LIBRARY_PATH=$G/lib GDAL_DATA=$G/share/gdal PROJ_DATA=$G/share/proj PROJ_LIB=$G/share/proj
-echo "== machine"; date -u; nproc; lscpu | grep -m1 "Model name"; free -g | head -2
+echo "== machine"; date -u; nproc; lscpu | grep -E "Model name|^Thread|^Core|^Socket|^NUMA node\(s\)|MHz"; free -g | head -2
 $G/bin/groundplan --version || { ldd $G/bin/groundplan | grep "not found"; exit 1; }
 
 line() {  # NAME STATS.json TIME.txt -> one line
