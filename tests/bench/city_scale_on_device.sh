@@ -23,11 +23,13 @@ import json, sys
 name, stats, tm = sys.argv[1:4]
 d = json.load(open(stats)); t = d["timings_s"]; r = d.get("reading", {})
 wall, user, sys_, rss = open(tm).read().split()[-4:]
-print("%-22s wall %6.2f s | read %6.2f fp %5.2f blocks %5.2f union %5.2f write %5.2f (index %4.2f) | cpu %6.1f s | "
-      "rss %5.0f MiB | threads %s chunked %s/%s files, %s chunks | plans %s" % (name, float(wall), t["read"],
-      t["footprints"], t["blocks"], t["union"], t["write"], t.get("spatial_index", 0), float(user) + float(sys_),
-      int(rss) / 1024, r.get("threads"), r.get("files_chunked"), r.get("files"), r.get("chunks"),
-      d["counts"]["ground_plans"]))
+si = d.get("spatial_index")
+idx = " [index read %.2f write %.2f commit %.2f]" % (si["read_s"], si["write_s"], si["commit_s"]) if si else ""
+print("%-22s wall %6.2f s | read %6.2f fp %5.2f blocks %5.2f union %5.2f write %5.2f (index %4.2f) | cpu %6.1f s "
+      "(sys %5.1f) | rss %5.0f MiB | threads %s chunked %s/%s files, %s chunks | plans %s%s" % (name, float(wall),
+      t["read"], t["footprints"], t["blocks"], t["union"], t["write"], t.get("spatial_index", 0),
+      float(user) + float(sys_), float(sys_), int(rss) / 1024, r.get("threads"), r.get("files_chunked"),
+      r.get("files"), r.get("chunks"), d["counts"]["ground_plans"], idx))
 PY
 }
 gp() {  # NAME ARGS... : one run, its line
@@ -67,6 +69,9 @@ print("index entries equal:", list(a.execute(q)) == list(b.execute(q)), "| schem
       list(a.execute(schema)) == list(b.execute(schema)), "| rtreecheck:",
       a.execute("SELECT rtreecheck('rtree_ground_plans_geom')").fetchone()[0])
 PY
+echo "== glibc malloc kept from returning memory to the kernel (GLIBC_TUNABLES), one file, all cores"
+for i in 1 2 3; do GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_threshold=1073741824 \
+  gp "file_tunables_$i" -f GPKG "$W/file_tunables_$i.gpkg" "$W/city.gml"; done
 if [ -e $G/lib/libtbbmalloc_proxy.so.2 ]; then
   echo "== TBB's allocator (LD_PRELOAD libtbbmalloc_proxy) against glibc's, one file, all cores"
   for i in 1 2 3; do LD_PRELOAD=$G/lib/libtbbmalloc_proxy.so.2 gp "file_tbbmalloc_$i" -f GPKG "$W/file_tbbmalloc_$i.gpkg" "$W/city.gml"; done
