@@ -379,3 +379,34 @@ def test_a_million_vertex_ring_in_geojson_ends_in_bounded_time(tmp_path):
     assert abs(plans_[0]["area_m2"] - math.pi * 100 ** 2) < 1
     assert [(q["source_id"], q["code"]) for q in layer_items(out, "problems") if q["code"] != "NOTE"] == \
         [("line", "NOT_AREAL")]
+
+
+def test_a_folder_of_shapefiles_and_geopackages_is_one_input(tmp_path, city_footprints):
+    """A folder of OGR files is read like a folder of tiles: each .shp/.gpkg/.fgb/.geojson is an input, sorted by
+    name; a shapefile's .dbf/.shx/.prj/.cpg are not inputs of their own. The plans are those of the whole."""
+    city = city_footprints["lorup"] if "lorup" in city_footprints else city_footprints["niiza"]
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    n = len(layer_items(city, "footprints"))
+    cuts = [0, n // 3, 2 * n // 3, n]
+    for k, (drv, ext, lco) in enumerate([("ESRI Shapefile", ".shp", ["-lco", "ENCODING=UTF-8"]),  # + a .cpg
+                                         ("ESRI Shapefile", ".shp", []), ("GPKG", ".gpkg", [])]):
+        run(["ogr2ogr", "-f", drv, *lco, folder / f"part{k}{ext}", city, "footprints", "-where",
+             f"fid > {cuts[k]} AND fid <= {cuts[k + 1]}", "-nln", f"part{k}"])
+    (folder / "notes.txt").write_text("not an input")
+    assert {p.suffix for p in folder.iterdir()} >= {".shp", ".dbf", ".shx", ".prj", ".cpg", ".gpkg", ".txt"}
+    out = tmp_path / "plans.gpkg"
+    run([BIN, "--id-field", "source_id", "--stats", tmp_path / "s.json", "-f", "GPKG", out, folder,
+         "ground_plans", "problems"])
+    stats = json.loads((tmp_path / "s.json").read_text())
+    assert stats["reading"]["files"] == 3 and stats["counts"]["buildings"] == n
+    assert plans(out) == plans(city)
+    assert [p for p in layer_items(out, "problems") if p["code"] != "NOTE"] == []
+    # A folder of sidecars only is refused, the message naming what a folder may hold.
+    for p in folder.glob("*.shp"):
+        p.unlink()
+    for p in folder.glob("*.gpkg"):
+        p.unlink()
+    r = run([BIN, "-f", "GPKG", tmp_path / "x.gpkg", folder], check=False)
+    assert r.returncode == 1 and "folder holds no input file" in r.stderr and "*.shp" in r.stderr
+
