@@ -338,19 +338,24 @@ int run(int argc, char** argv) {
   app.add_option("--input-oo", ogr_in.open_options, "OGR source: NAME=VALUE open option of its driver (repeatable)");
   app.add_option("--id-field", ogr_in.id_field, "OGR source: field holding the building id (default: the FID)");
   app.add_option("--group-by", ogr_in.group_by, "OGR source: features sharing this field's value are one building");
+  app.add_option("--input-geom-field", ogr_in.geom_field,
+                 "OGR source: the geometry field to read where a layer has several (default: the first)");
   app.add_option("--lod", lod, "Level of detail to read: -1 (highest per building), 0..4, or with CityJSON's "
                                "refinement as 3DBAG names it (1.2, 1.3, 2.2)");
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
   app.add_option("--preview", preview_path, "Write a PNG map of the plans (holes open, problem buildings in red)");
   int threads = 0;
-  std::int64_t read_chunk_bytes = 0;
+  std::int64_t read_chunk_bytes = 0, read_range_features = 0;
   auto* o_threads = app.add_option("--threads", threads, "Threads for every stage (0 = all cores; default: GDAL's "
                                                          "GDAL_NUM_THREADS config option, else all cores)")
                         ->check(CLI::NonNegativeNumber);
   app.add_option("--read-chunk-bytes", read_chunk_bytes,
                  "CityGML files are cut into chunks of about this many bytes read side by side (0 = automatic, "
                  "-1 = never); the result is the same either way");
+  app.add_option("--read-range-features", read_range_features,
+                 "OGR sources are cut into ranges of about this many features read side by side, one dataset handle "
+                 "each (0 = automatic, -1 = never); the result is the same either way");
   // Level of detail (issue 9, docs/level_of_detail.md): off by default, the exact union.
   std::string preset = "none", resolution_mode = "exact";
   groundplan::LodParams lod_flags;
@@ -425,6 +430,7 @@ int run(int argc, char** argv) {
   else if (const char* v = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))
     options.threads = groundplan::gis::threads_from_string(v, "GDAL_NUM_THREADS");
   options.read_chunk_bytes = read_chunk_bytes;
+  options.read_range_features = read_range_features;
 
   const double cpu0 = groundplan::gis::process_cpu_seconds();
   const auto t0 = clock::now();

@@ -61,6 +61,7 @@ const char* open_option_list_xml() {
          "  <Option name='INPUT_OO' type='string' description='OGR sources: comma-separated NAME=VALUE open options of the source driver'/>"
          "  <Option name='ID_FIELD' type='string' description='OGR sources: field holding the building id (default: the FID)'/>"
          "  <Option name='GROUP_BY' type='string' description='OGR sources: features sharing this field&apos;s value are one building'/>"
+         "  <Option name='INPUT_GEOM_FIELD' type='string' description='OGR sources: the geometry field to read where a layer has several (default: the first)'/>"
          "  <Option name='NUM_THREADS' type='string' description='Threads for every stage: a number or ALL_CPUS "
          "(default: the GDAL_NUM_THREADS config option, else all cores)' default='ALL_CPUS'/>"
          "</OpenOptionList>";
@@ -138,6 +139,7 @@ gis::PipelineOptions pipeline_options_from(const std::string& connection, char**
   o.ogr_input.dialect = CSLFetchNameValueDef(open_options, "INPUT_DIALECT", "");
   o.ogr_input.id_field = CSLFetchNameValueDef(open_options, "ID_FIELD", "");
   o.ogr_input.group_by = CSLFetchNameValueDef(open_options, "GROUP_BY", "");
+  o.ogr_input.geom_field = CSLFetchNameValueDef(open_options, "INPUT_GEOM_FIELD", "");
   if (const char* v = CSLFetchNameValue(open_options, "NUM_THREADS"))
     o.threads = gis::threads_from_string(v, "open option NUM_THREADS");
   else if (const char* g = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))

@@ -41,8 +41,16 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// Files named by the inputs: a file as is, a folder or a .zip as its input files (CityGML, KML/KMZ, glTF;
-/// not .dae, which belong to a .kml beside them) sorted by name.
+/// The OGR files a folder is expanded to (issue 22): one file, one dataset (a .shp's .dbf/.shx/.prj/.cpg
+/// belong to it and are not inputs themselves).
+bool is_ogr_input_name(const std::string& name) {
+  const std::string ext = lower(fs::path(name).extension().string());
+  return ext == ".shp" || ext == ".gpkg" || ext == ".fgb" || ext == ".geojson";
+}
+
+/// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF, CityJSON;
+/// not .dae, which belong to a .kml beside them; Shapefile, GeoPackage, FlatGeobuf, GeoJSON) sorted by name,
+/// a .zip as its city files.
 std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
@@ -50,10 +58,13 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, s
     if (fs::is_directory(in, ec)) {
       std::vector<std::string> found;
       for (const auto& e : fs::directory_iterator(in, ec))
-        if (e.is_regular_file() && is_input_name(e.path().filename().string())) found.push_back(e.path().string());
+        if (e.is_regular_file() && (is_input_name(e.path().filename().string()) ||
+                                    is_ogr_input_name(e.path().filename().string())))
+          found.push_back(e.path().string());
       std::sort(found.begin(), found.end());
       if (found.empty())
-        throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb)");
+        throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb, "
+                              "*.city.json, *.city.jsonl, *.shp, *.gpkg, *.fgb, *.geojson)");
       files.insert(files.end(), found.begin(), found.end());
     } else if (lower(fs::path(in).extension().string()) == ".zip") {
       // A zip of tiles: its input entries, sorted (read through GDAL's /vsizip/, side by side like a folder).

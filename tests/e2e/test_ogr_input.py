@@ -379,3 +379,142 @@ def test_a_million_vertex_ring_in_geojson_ends_in_bounded_time(tmp_path):
     assert abs(plans_[0]["area_m2"] - math.pi * 100 ** 2) < 1
     assert [(q["source_id"], q["code"]) for q in layer_items(out, "problems") if q["code"] != "NOTE"] == \
         [("line", "NOT_AREAL")]
+
+
+def test_a_folder_of_shapefiles_and_geopackages_is_one_input(tmp_path, city_footprints):
+    """A folder of OGR files is read like a folder of tiles: each .shp/.gpkg/.fgb/.geojson is an input, sorted by
+    name; a shapefile's .dbf/.shx/.prj/.cpg are not inputs of their own. The plans are those of the whole."""
+    city = city_footprints["lorup"] if "lorup" in city_footprints else city_footprints["niiza"]
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    n = len(layer_items(city, "footprints"))
+    cuts = [0, n // 3, 2 * n // 3, n]
+    for k, (drv, ext, lco) in enumerate([("ESRI Shapefile", ".shp", ["-lco", "ENCODING=UTF-8"]),  # + a .cpg
+                                         ("ESRI Shapefile", ".shp", []), ("GPKG", ".gpkg", [])]):
+        run(["ogr2ogr", "-f", drv, *lco, folder / f"part{k}{ext}", city, "footprints", "-where",
+             f"fid > {cuts[k]} AND fid <= {cuts[k + 1]}", "-nln", f"part{k}"])
+    (folder / "notes.txt").write_text("not an input")
+    assert {p.suffix for p in folder.iterdir()} >= {".shp", ".dbf", ".shx", ".prj", ".cpg", ".gpkg", ".txt"}
+    out = tmp_path / "plans.gpkg"
+    run([BIN, "--id-field", "source_id", "--stats", tmp_path / "s.json", "-f", "GPKG", out, folder,
+         "ground_plans", "problems"])
+    stats = json.loads((tmp_path / "s.json").read_text())
+    assert stats["reading"]["files"] == 3 and stats["counts"]["buildings"] == n
+    assert plans(out) == plans(city)
+    assert [p for p in layer_items(out, "problems") if p["code"] != "NOTE"] == []
+    # A folder of sidecars only is refused, the message naming what a folder may hold.
+    for p in folder.glob("*.shp"):
+        p.unlink()
+    for p in folder.glob("*.gpkg"):
+        p.unlink()
+    r = run([BIN, "-f", "GPKG", tmp_path / "x.gpkg", folder], check=False)
+    assert r.returncode == 1 and "folder holds no input file" in r.stderr and "*.shp" in r.stderr
+
+
+def _two_geometry_sqlite(path):
+    """An SQLite table (GDAL's SQLite driver keeps several geometry columns) with a footprint and a roof column."""
+    ds = ogr.GetDriverByName("SQLite").CreateDataSource(str(path))
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(25832)
+    lyr = ds.CreateLayer("houses", None, ogr.wkbNone)
+    for name in ("footprint", "roof"):
+        gfd = ogr.GeomFieldDefn(name, ogr.wkbPolygon)
+        gfd.SetSpatialRef(srs)
+        lyr.CreateGeomField(gfd)
+    lyr.CreateField(ogr.FieldDefn("name", ogr.OFTString))
+    for i in range(3):
+        f = ogr.Feature(lyr.GetLayerDefn())
+        f["name"] = f"h{i}"
+        x = 400000 + 30 * i
+        f.SetGeomField(0, ogr.CreateGeometryFromWkt(
+            f"POLYGON (({x} 5800000,{x + 10} 5800000,{x + 10} 5800010,{x} 5800010,{x} 5800000))"))
+        f.SetGeomField(1, ogr.CreateGeometryFromWkt(  # the roof overhangs: 12 x 12
+            f"POLYGON (({x - 1} 5799999,{x + 11} 5799999,{x + 11} 5800011,{x - 1} 5800011,{x - 1} 5799999))"))
+        lyr.CreateFeature(f)
+    ds = None
+
+
+def test_a_layer_with_several_geometry_fields_reads_the_first_or_the_one_named(tmp_path):
+    src = tmp_path / "houses.sqlite"
+    _two_geometry_sqlite(src)
+    out = tmp_path / "first.gpkg"
+    run([BIN, "--id-field", "name", "-f", "GPKG", out, src, "ground_plans", "problems"])
+    assert sorted(round(p["area_m2"]) for p in layer_items(out, "ground_plans")) == [100, 100, 100]
+    notes = [p["reason"] for p in layer_items(out, "problems") if p["code"] == "NOTE"]
+    assert any("2 geometry fields ('footprint', 'roof'): only 'footprint' is read" in n for n in notes), notes
+    out = tmp_path / "roof.gpkg"
+    run([BIN, "--id-field", "name", "--input-geom-field", "roof", "-f", "GPKG", out, src, "ground_plans", "problems"])
+    assert sorted(round(p["area_m2"]) for p in layer_items(out, "ground_plans")) == [144, 144, 144]
+    notes = [p["reason"] for p in layer_items(out, "problems") if p["code"] == "NOTE"]
+    assert any("only 'roof' is read" in n for n in notes), notes
+    # The driver's open option, through GDAL's own ogr2ogr.
+    out = tmp_path / "driver.gpkg"
+    run(["ogr2ogr", "-f", "GPKG", "-oo", "INPUT_GEOM_FIELD=roof", "-oo", "ID_FIELD=name", out, f"GROUNDPLAN:{src}",
+         "ground_plans"])
+    assert sorted(round(p["area_m2"]) for p in layer_items(out, "ground_plans")) == [144, 144, 144]
+    r = run([BIN, "--input-geom-field", "walls", "-f", "GPKG", tmp_path / "x.gpkg", src], check=False)
+    assert r.returncode == 1 and str(src) in r.stderr and "no geometry field 'walls'" in r.stderr
+    assert "'footprint', 'roof'" in r.stderr
+
+
+def _ten_squares_shapefile(path):
+    ds = ogr.GetDriverByName("ESRI Shapefile").CreateDataSource(str(path))
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(25832)
+    lyr = ds.CreateLayer(path.stem, srs, ogr.wkbPolygon)
+    lyr.CreateField(ogr.FieldDefn("name", ogr.OFTString))
+    for i in range(10):
+        f = ogr.Feature(lyr.GetLayerDefn())
+        f["name"] = f"b{i}"
+        x = 400000 + 20 * i
+        f.SetGeometry(ogr.CreateGeometryFromWkt(
+            f"POLYGON (({x} 5800000,{x + 10} 5800000,{x + 10} 5800010,{x} 5800010,{x} 5800000))"))
+        lyr.CreateFeature(f)
+    ds = None
+
+
+@pytest.mark.parametrize("threads", ["1", "3"])
+def test_a_dbf_cut_short_mid_record_stops_the_layer_with_unreadable_features(tmp_path, threads):
+    """The .dbf ends inside record 5 of 10: GDAL fails there and gives no more features. The layer's problem says
+    how many were read and how many the layer counts; the features read are all members (features = members +
+    problems), and the run with ranges on 3 threads gives up its ranges and says the same."""
+    shp = tmp_path / "cut.shp"
+    _ten_squares_shapefile(shp)
+    dbf = tmp_path / "cut.dbf"
+    data = dbf.read_bytes()
+    header_len = int.from_bytes(data[8:10], "little")
+    record_len = int.from_bytes(data[10:12], "little")
+    dbf.write_bytes(data[:header_len + 4 * record_len + record_len // 2])
+    out = tmp_path / "o.gpkg"
+    run([BIN, "--id-field", "name", "--threads", threads, "--read-range-features", "2", "--stats", tmp_path / "s.json",
+         "-f", "GPKG", out, shp, "footprints", "problems"])
+    fps = [f["source_id"] for f in layer_items(out, "footprints")]
+    problems = [p for p in layer_items(out, "problems") if p["code"] != "NOTE"]
+    assert fps == ["b0", "b1", "b2", "b3"]
+    assert [p["code"] for p in problems] == ["UNREADABLE_FEATURES"]
+    reason = problems[0]["reason"]
+    assert problems[0]["file"] == str(shp) and "layer 'cut'" in reason and "DBF" in reason
+    assert "after 4 features of the 10 the layer counts" in reason
+    features_read = int(re.search(r"after (\d+) features", reason).group(1))
+    assert features_read == len(fps) + len([p for p in problems if p["source_id"]])  # features = members + problems
+    stats = json.loads((tmp_path / "s.json").read_text())
+    if threads == "3":
+        assert stats["reading"]["chunks"] == 0 and "range" in stats["reading"]["read_whole"][0]["why"]
+
+
+def test_a_shp_cut_short_mid_record_names_each_feature_left_without_geometry(tmp_path):
+    """The .shp ends inside record 7 (the .shx and .dbf whole): GDAL gives features 6-9 without geometry, each
+    an EMPTY_GEOMETRY problem naming its FID and GDAL's fread error; nothing is dropped silently."""
+    shp = tmp_path / "cut.shp"
+    _ten_squares_shapefile(shp)
+    data = shp.read_bytes()
+    record = (len(data) - 100) // 10
+    shp.write_bytes(data[:100 + 6 * record + record // 2])
+    out = tmp_path / "o.gpkg"
+    run([BIN, "--id-field", "name", "-f", "GPKG", out, shp, "footprints", "problems"])
+    fps = [f["source_id"] for f in layer_items(out, "footprints")]
+    problems = [p for p in layer_items(out, "problems") if p["code"] != "NOTE"]
+    assert fps == [f"b{i}" for i in range(6)]
+    assert [(p["source_id"], p["code"]) for p in problems] == [(f"b{i}", "EMPTY_GEOMETRY") for i in range(6, 10)]
+    assert all(f"FID {i}" in p["reason"] and "fread" in p["reason"] for i, p in zip(range(6, 10), problems))
+    assert len(fps) + len(problems) == 10

@@ -4,6 +4,8 @@
 #include <groundplan/error.h>
 #include <groundplan/gis/ogr_input.h>
 
+#include "ogr/ogr_source.h"
+
 #include <cpl_error.h>
 #include <cpl_string.h>
 #include <gdal_priv.h>
@@ -15,9 +17,12 @@
 #include <memory>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 
 namespace groundplan::gis {
 namespace {
+
+using ogr_detail::LayerPlan;
 
 constexpr const char* kOwnDriver = "GroundPlan";
 constexpr double kPi = 3.14159265358979323846;
@@ -47,46 +52,6 @@ CPLStringList vector_drivers() {
   }
   return names;
 }
-
-/// GDAL's errors while this object lives, on this thread only (GDAL's handler stack is per thread):
-/// they become Problems instead of lines on stderr.
-class ErrorCollector {
- public:
-  ErrorCollector() { CPLPushErrorHandlerEx(&ErrorCollector::handler, this); }
-  ~ErrorCollector() { CPLPopErrorHandler(); }
-  ErrorCollector(const ErrorCollector&) = delete;
-  ErrorCollector& operator=(const ErrorCollector&) = delete;
-
-  /// Messages since the last take(), joined; empty when none.
-  std::string take() {
-    std::string out;
-    for (const std::string& m : messages_) out += (out.empty() ? "" : "; ") + m;
-    if (dropped_) out += "; and " + std::to_string(dropped_) + " more GDAL messages";
-    messages_.clear();
-    dropped_ = 0;
-    failure_ = false;
-    return out;
-  }
-  bool failure() const { return failure_; }
-
- private:
-  static void CPL_STDCALL handler(CPLErr cls, CPLErrorNum, const char* msg) {
-    auto* self = static_cast<ErrorCollector*>(CPLGetErrorHandlerUserData());
-    if (!self || cls == CE_Debug) return;
-    if (cls >= CE_Failure) self->failure_ = true;
-    if (self->messages_.size() < 5)
-      self->messages_.emplace_back(std::string(cls >= CE_Failure ? "GDAL error: " : "GDAL warning: ") + (msg ? msg : ""));
-    else
-      ++self->dropped_;
-  }
-  std::vector<std::string> messages_;
-  std::size_t dropped_ = 0;
-  bool failure_ = false;
-};
-
-struct DatasetCloser {
-  void operator()(GDALDataset* ds) const { GDALClose(GDALDataset::ToHandle(ds)); }
-};
 
 /// "EPSG:n" when the CRS is one, else WKT2: what parse_srs_name / PROJ take.
 std::string srs_definition(const OGRSpatialReference& srs) {
@@ -220,23 +185,51 @@ void append_mesh(const Mesh& from, Mesh& to) {
   }
 }
 
-struct LayerPlan {
-  OGRLayer* layer = nullptr;
-  std::string name;
-  int id_index = -1;     // --id-field, -1 = the FID
-  int group_index = -1;  // --group-by, -1 = none
-  std::unique_ptr<OGRCoordinateTransformation> to_source;  // into the file's source CRS; null = none needed
-  bool no_crs = false;   // the file has a CRS and this layer has none
-};
-
-/// The layer's CRS; null when it has none, GeoPackage's "Undefined geographic/cartesian SRS" included
-/// (srs_id 0 / -1: the writer knew no CRS, so reading its numbers as degrees would be a guess).
-const OGRSpatialReference* layer_srs(OGRLayer* layer) {
-  const OGRSpatialReference* srs = layer->GetSpatialRef();
+/// The CRS of the layer's geometry field `geom`; null when it has none, GeoPackage's "Undefined
+/// geographic/cartesian SRS" included (srs_id 0 / -1: the writer knew no CRS, so reading its numbers as
+/// degrees would be a guess).
+const OGRSpatialReference* layer_srs(OGRLayer* layer, int geom) {
+  OGRFeatureDefn* defn = layer->GetLayerDefn();
+  const OGRSpatialReference* srs = geom >= 0 && geom < defn->GetGeomFieldCount()
+                                       ? defn->GetGeomFieldDefn(geom)->GetSpatialRef() : layer->GetSpatialRef();
   if (!srs || srs->IsEmpty()) return nullptr;
   const char* name = srs->GetName();
   if (!srs->GetAuthorityName(nullptr) && name && STARTS_WITH_CI(name, "Undefined ")) return nullptr;
   return srs;
+}
+
+/// --input-geom-field: the geometry field each layer reads (the first when not named, or when a layer
+/// lacks the named one but another has it); a NOTE for every layer whose other geometry fields are left.
+void choose_geometry_fields(std::vector<LayerPlan>& plans, const std::string& field, const std::string& path,
+                            std::vector<Problem>& problems) {
+  auto names = [](OGRFeatureDefn* defn) {
+    std::string out;
+    for (int k = 0; k < defn->GetGeomFieldCount() && k < 40; ++k)
+      out += (k ? ", " : "") + std::string("'") + defn->GetGeomFieldDefn(k)->GetNameRef() + "'";
+    return out.empty() ? std::string("none") : out;
+  };
+  bool anywhere = field.empty();
+  for (LayerPlan& p : plans) {
+    p.geom_index = field.empty() ? 0 : p.layer->GetLayerDefn()->GetGeomFieldIndex(field.c_str());
+    anywhere = anywhere || p.geom_index >= 0;
+  }
+  if (!anywhere)
+    throw InputError(path + ": layer '" + plans.front().name + "' has no geometry field '" + field +
+                     "' (--input-geom-field); its geometry fields: " + names(plans.front().layer->GetLayerDefn()));
+  for (LayerPlan& p : plans) {
+    OGRFeatureDefn* defn = p.layer->GetLayerDefn();
+    if (p.geom_index < 0) {
+      p.geom_index = 0;
+      problems.push_back({"", path, "read", "NOTE", "layer '" + p.name + "' has no geometry field '" + field +
+                                                        "' (--input-geom-field): its first one is read"});
+    }
+    if (defn->GetGeomFieldCount() > 1)
+      problems.push_back({"", path, "read", "NOTE",
+                          "layer '" + p.name + "' has " + std::to_string(defn->GetGeomFieldCount()) +
+                              " geometry fields (" + names(defn) + "): only '" +
+                              defn->GetGeomFieldDefn(p.geom_index)->GetNameRef() +
+                              "' is read, the others are ignored (--input-geom-field NAME chooses)"});
+  }
 }
 
 /// The index of `field` in the layer, -1 when absent (or not asked for).
@@ -288,44 +281,63 @@ bool ogr_can_read(const std::string& path) {
   }
 }
 
-void read_ogr(const std::string& path, const OgrInputOptions& options, const std::function<void()>& source_srs_ready,
-              const std::function<void(Mesh&&)>& on_mesh, std::vector<Problem>& problems, OgrInfo& info) {
+
+namespace ogr_detail {
+
+ErrorCollector::ErrorCollector() { CPLPushErrorHandlerEx(&ErrorCollector::handler, this); }
+ErrorCollector::~ErrorCollector() { CPLPopErrorHandler(); }
+
+std::string ErrorCollector::take() {
+  std::string out;
+  for (const std::string& m : messages_) out += (out.empty() ? "" : "; ") + m;
+  if (dropped_) out += "; and " + std::to_string(dropped_) + " more GDAL messages";
+  messages_.clear();
+  dropped_ = 0;
+  failure_ = false;
+  return out;
+}
+
+void CPL_STDCALL ErrorCollector::handler(CPLErr cls, CPLErrorNum, const char* msg) {
+  auto* self = static_cast<ErrorCollector*>(CPLGetErrorHandlerUserData());
+  if (!self || cls == CE_Debug) return;
+  if (cls >= CE_Failure) self->failure_ = true;
+  if (self->messages_.size() < 5)
+    self->messages_.emplace_back(std::string(cls >= CE_Failure ? "GDAL error: " : "GDAL warning: ") + (msg ? msg : ""));
+  else
+    ++self->dropped_;
+}
+
+void open_source(const std::string& path, const OgrInputOptions& options, Source& src, std::vector<Problem>& problems,
+                 OgrInfo& info) {
   ensure_registered();
-  info = OgrInfo{};
-  ErrorCollector errors;
+  ErrorCollector& errors = src.errors;
   const CPLStringList drivers = vector_drivers();
   CPLStringList open_options;
   for (const std::string& o : options.open_options) open_options.AddString(o.c_str());
-  std::unique_ptr<GDALDataset, DatasetCloser> ds(GDALDataset::FromHandle(
+  src.ds.reset(GDALDataset::FromHandle(
       GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers.List(), open_options.List(), nullptr)));
-  if (!ds) {
+  if (!src.ds) {
     const std::string why = errors.take();
     // A damaged .shx index: GDAL can rebuild it from the .shp (it writes a new .shx), but only when asked.
     const bool shx = why.find(".shx") != std::string::npos;
     throw InputError(path + ": GDAL cannot open it as a vector source" + (why.empty() ? "" : " (" + why + ")") +
                      (shx ? "; if the .shx index is damaged, --config SHAPE_RESTORE_SHX YES rebuilds it from the .shp" : ""));
   }
+  GDALDataset* ds = src.ds.get();
   if (GDALDriver* d = ds->GetDriver()) info.driver = d->GetDescription();
 
   // The layers to read: an SQL result, the named ones, or all.
-  struct SqlResult {
-    GDALDataset* ds;
-    OGRLayer* layer;
-    ~SqlResult() {
-      if (layer) ds->ReleaseResultSet(layer);
-    }
-  } sql{ds.get(), nullptr};
-  std::vector<LayerPlan> plans;
+  std::vector<LayerPlan>& plans = src.plans;
   if (!options.sql.empty() && (!options.where.empty() || !options.layers.empty()))
     throw InputError(path + ": --input-sql names its own layer and condition: --input-layer and --input-where "
                           "do not apply to it (put them in the statement)");
   if (!options.sql.empty()) {
-    sql.layer = ds->ExecuteSQL(options.sql.c_str(), nullptr, options.dialect.empty() ? nullptr : options.dialect.c_str());
-    if (!sql.layer) {
+    src.sql_layer = ds->ExecuteSQL(options.sql.c_str(), nullptr, options.dialect.empty() ? nullptr : options.dialect.c_str());
+    if (!src.sql_layer) {
       const std::string why = errors.take();
       throw InputError(path + ": --input-sql gave no layer" + (why.empty() ? "" : " (" + why + ")") + ": " + options.sql);
     }
-    plans.push_back(LayerPlan{sql.layer, sql.layer->GetName(), -1, -1, nullptr, false});
+    plans.push_back(LayerPlan{src.sql_layer, src.sql_layer->GetName()});
   } else if (!options.layers.empty()) {
     for (const std::string& name : options.layers) {
       OGRLayer* l = ds->GetLayerByName(name.c_str());
@@ -334,10 +346,10 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
         for (int i = 0; i < ds->GetLayerCount() && i < 40; ++i) names += (i ? ", " : "") + std::string(ds->GetLayer(i)->GetName());
         throw InputError(path + ": has no layer '" + name + "' (--input-layer); its layers: " + (names.empty() ? "none" : names));
       }
-      plans.push_back(LayerPlan{l, name, -1, -1, nullptr, false});
+      plans.push_back(LayerPlan{l, name});
     }
   } else {
-    for (int i = 0; i < ds->GetLayerCount(); ++i) plans.push_back(LayerPlan{ds->GetLayer(i), ds->GetLayer(i)->GetName(), -1, -1, nullptr, false});
+    for (int i = 0; i < ds->GetLayerCount(); ++i) plans.push_back(LayerPlan{ds->GetLayer(i), ds->GetLayer(i)->GetName()});
   }
   if (plans.empty()) throw InputError(path + ": GDAL (" + info.driver + ") opens it, but it has no vector layer");
 
@@ -352,16 +364,19 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
     p.id_index = field_index(p.layer, options.id_field);
     p.group_index = field_index(p.layer, options.group_by);
     info.layers.push_back(p.name);
-    const OGRSpatialReference* srs = layer_srs(p.layer);
-    if (srs && !source) source.reset(srs->Clone());
   }
   check_field(plans, options.id_field, &LayerPlan::id_index, path, "--id-field", problems);
   check_field(plans, options.group_by, &LayerPlan::group_index, path, "--group-by", problems);
+  choose_geometry_fields(plans, options.geom_field, path, problems);
+  for (LayerPlan& p : plans) {
+    const OGRSpatialReference* srs = layer_srs(p.layer, p.geom_index);
+    if (srs && !source) source.reset(srs->Clone());
+  }
   if (source) {
     info.source_srs = srs_definition(*source);
     info.east_north = data_east_north(*source);
     for (LayerPlan& p : plans) {
-      const OGRSpatialReference* srs = layer_srs(p.layer);
+      const OGRSpatialReference* srs = layer_srs(p.layer, p.geom_index);
       if (!srs) {
         p.no_crs = true;
       } else if (!srs->IsSame(source.get())) {
@@ -373,102 +388,127 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
     }
   }
   if (const std::string said = errors.take(); !said.empty()) problems.push_back({"", path, "read", "NOTE", said});
-  if (source_srs_ready) source_srs_ready();
+}
 
-  const bool prefix_layer = plans.size() > 1;
-  // --group-by: one mesh per value, delivered at the end in first-seen order (memory: the file's meshes).
-  std::vector<Mesh> groups;
-  std::unordered_map<std::string, std::size_t> group_of;
+void FeatureReader::read(LayerPlan& p, OGRFeature& feature) {
+  ++info_.features;
+  ++layer_features_;
+  const GIntBig fid = feature.GetFID();
+  const std::string fid_text = fid == OGRNullFID ? std::string("(no FID)") : std::to_string(fid);
+  std::string id;
+  if (p.id_index >= 0 && feature.IsFieldSetAndNotNull(p.id_index)) id = feature.GetFieldAsString(p.id_index);
+  if (id.empty()) id = prefix_layer_ ? p.name + ":" + fid_text : fid_text;
+  std::optional<std::string> group;
+  if (p.group_index >= 0 && feature.IsFieldSetAndNotNull(p.group_index)) group = feature.GetFieldAsString(p.group_index);
+  auto building = [&] { return group ? *group : id; };  // before id moves into the mesh
+  auto where = [&] { return "layer '" + p.name + "', FID " + fid_text + ": "; };
+  const std::string gdal = src_.errors.take();
+  auto bad = [&](const char* code, const std::string& what) {
+    ++info_.features_bad;
+    problems_.push_back({building(), path_, "read", code, where() + what + (gdal.empty() ? "" : " (" + gdal + ")")});
+  };
 
-  auto read_feature = [&](LayerPlan& p, OGRFeature& feature) {
-    ++info.features;
-    const GIntBig fid = feature.GetFID();
-    const std::string fid_text = fid == OGRNullFID ? std::string("(no FID)") : std::to_string(fid);
-    std::string id;
-    if (p.id_index >= 0 && feature.IsFieldSetAndNotNull(p.id_index)) id = feature.GetFieldAsString(p.id_index);
-    if (id.empty()) id = prefix_layer ? p.name + ":" + fid_text : fid_text;
-    std::optional<std::string> group;
-    if (p.group_index >= 0 && feature.IsFieldSetAndNotNull(p.group_index)) group = feature.GetFieldAsString(p.group_index);
-    auto building = [&] { return group ? *group : id; };  // before id moves into the mesh
-    auto where = [&] { return "layer '" + p.name + "', FID " + fid_text + ": "; };
-    const std::string gdal = errors.take();
-    auto bad = [&](const char* code, const std::string& what) {
-      ++info.features_bad;
-      problems.push_back({building(), path, "read", code, where() + what + (gdal.empty() ? "" : " (" + gdal + ")")});
-    };
-
-    OGRGeometry* geom = feature.GetGeometryRef();
-    if (!geom || geom->IsEmpty()) return bad("EMPTY_GEOMETRY", "the feature has no geometry (null or empty)");
-    if (p.no_crs)
-      return bad("NO_CRS", "the layer has no CRS while the file's others have " + info.source_srs.substr(0, 60) +
-                               ": its coordinates cannot be placed");
-    std::unique_ptr<OGRGeometry> owned;
-    if (geom->hasCurveGeometry()) {
-      owned.reset(geom->getLinearGeometry());
-      if (!owned) return bad("BAD_GEOMETRY", "the curve geometry could not be linearised");
+  OGRGeometry* geom = feature.GetGeomFieldRef(p.geom_index);
+  if (!geom || geom->IsEmpty()) return bad("EMPTY_GEOMETRY", "the feature has no geometry (null or empty)");
+  if (p.no_crs)
+    return bad("NO_CRS", "the layer has no CRS while the file's others have " + info_.source_srs.substr(0, 60) +
+                             ": its coordinates cannot be placed");
+  std::unique_ptr<OGRGeometry> owned;
+  if (geom->hasCurveGeometry()) {
+    owned.reset(geom->getLinearGeometry());
+    if (!owned) return bad("BAD_GEOMETRY", "the curve geometry could not be linearised");
+    geom = owned.get();
+  }
+  if (p.to_source) {
+    if (!owned) {
+      owned.reset(geom->clone());
       geom = owned.get();
     }
-    if (p.to_source) {
-      if (!owned) {
-        owned.reset(geom->clone());
-        geom = owned.get();
-      }
-      if (geom->transform(p.to_source.get()) != OGRERR_NONE)
-        return bad("TRANSFORM_FAILED", "its coordinates cannot be transformed into the file's CRS");
+    if (geom->transform(p.to_source.get()) != OGRERR_NONE)
+      return bad("TRANSFORM_FAILED", "its coordinates cannot be transformed into the file's CRS");
+  }
+  Faces f;
+  collect(geom, f, 0);
+  if (f.mesh.faces.empty())
+    return bad("NOT_AREAL", std::string("a ") + OGRGeometryTypeToName(geom->getGeometryType()) +
+                                " has no area: only polygons and surfaces are footprints");
+  if (f.non_finite) return bad("BAD_COORDINATES", "a coordinate is NaN or infinite");
+  if (f.max_abs > options_.max_abs_coordinate)
+    return bad("COORDINATE_OUT_OF_RANGE", "a coordinate's magnitude exceeds " + std::to_string(options_.max_abs_coordinate));
+  if (f.mesh.vertices.size() > options_.max_vertices)
+    return bad("TOO_MANY_VERTICES", std::to_string(f.mesh.vertices.size()) + " vertices, more than the limit of " +
+                                        std::to_string(options_.max_vertices));
+  if (!gdal.empty())  // GDAL said something about a feature it still gave: kept, and said
+    problems_.push_back({building(), path_, "read", "NOTE", where() + gdal});
+  if (f.non_areal)
+    problems_.push_back({building(), path_, "read", "NON_AREAL_PARTS",
+                         where() + std::to_string(f.non_areal) + " point or line parts of the geometry are left out "
+                                 "(no area); its polygons are used"});
+  classify(f.mesh, geom->Is3D());
+  if (group) {
+    auto [it, fresh] = group_of_.try_emplace(*group, groups_.size());
+    if (fresh) {
+      Mesh& m = groups_.emplace_back();
+      m.source_id = *group;
+      m.source_file = path_;
+      m.name = p.name;
     }
-    Faces f;
-    collect(geom, f, 0);
-    if (f.mesh.faces.empty())
-      return bad("NOT_AREAL", std::string("a ") + OGRGeometryTypeToName(geom->getGeometryType()) +
-                                  " has no area: only polygons and surfaces are footprints");
-    if (f.non_finite) return bad("BAD_COORDINATES", "a coordinate is NaN or infinite");
-    if (f.max_abs > options.max_abs_coordinate)
-      return bad("COORDINATE_OUT_OF_RANGE", "a coordinate's magnitude exceeds " + std::to_string(options.max_abs_coordinate));
-    if (f.mesh.vertices.size() > options.max_vertices)
-      return bad("TOO_MANY_VERTICES", std::to_string(f.mesh.vertices.size()) + " vertices, more than the limit of " +
-                                          std::to_string(options.max_vertices));
-    if (!gdal.empty())  // GDAL said something about a feature it still gave: kept, and said
-      problems.push_back({building(), path, "read", "NOTE", where() + gdal});
-    if (f.non_areal)
-      problems.push_back({building(), path, "read", "NON_AREAL_PARTS",
-                          where() + std::to_string(f.non_areal) + " point or line parts of the geometry are left out "
-                                  "(no area); its polygons are used"});
-    classify(f.mesh, geom->Is3D());
-    if (group) {
-      auto [it, fresh] = group_of.try_emplace(*group, groups.size());
-      if (fresh) {
-        Mesh& m = groups.emplace_back();
-        m.source_id = *group;
-        m.source_file = path;
-        m.name = p.name;
-      }
-      append_mesh(f.mesh, groups[it->second]);
-      return;
-    }
-    Mesh& m = f.mesh;
-    m.source_id = std::move(id);
-    m.source_file = path;
-    m.name = p.name;
-    ++info.buildings;
-    on_mesh(std::move(m));
-  };
+    append_mesh(f.mesh, groups_[it->second]);
+    return;
+  }
+  Mesh& m = f.mesh;
+  m.source_id = std::move(id);
+  m.source_file = path_;
+  m.name = p.name;
+  ++info_.buildings;
+  on_mesh_(std::move(m));
+}
 
-  auto layer_stopped = [&](const LayerPlan& p) {
-    // A GDAL failure that ended the layer (a cut-short file ...): say so; features after it are not read.
-    if (!errors.failure()) {
-      const std::string warnings = errors.take();
-      if (!warnings.empty()) problems.push_back({"", path, "read", "NOTE", "layer '" + p.name + "': " + warnings});
-      return;
-    }
-    problems.push_back({"", path, "read", "UNREADABLE_FEATURES",
-                        "layer '" + p.name + "': reading stopped after " + std::to_string(info.features) +
-                            " features: " + errors.take()});
-  };
+void FeatureReader::layer_stopped(const LayerPlan& p) {
+  const std::size_t read = std::exchange(layer_features_, 0);
+  // A GDAL failure that ended the layer (a cut-short file ...): say so; features after it are not read.
+  if (!src_.errors.failure()) {
+    const std::string warnings = src_.errors.take();
+    if (!warnings.empty()) problems_.push_back({"", path_, "read", "NOTE", "layer '" + p.name + "': " + warnings});
+    return;
+  }
+  const std::string why = src_.errors.take();
+  // How many are lost, where the layer knows its count (a shapefile's .shx, a GeoPackage's contents table).
+  std::string of;
+  if (p.layer->TestCapability(OLCFastFeatureCount)) {
+    const GIntBig n = p.layer->GetFeatureCount(FALSE);
+    if (n >= 0 && static_cast<std::size_t>(n) >= read)
+      of = " of the " + std::to_string(n) + " the layer counts (" + std::to_string(static_cast<std::size_t>(n) - read) +
+           " not read)";
+    src_.errors.take();
+  }
+  problems_.push_back({"", path_, "read", "UNREADABLE_FEATURES",
+                       "layer '" + p.name + "': reading stopped after " + std::to_string(read) + " features" + of +
+                           ": " + why});
+}
 
+void FeatureReader::deliver_groups() {
+  for (Mesh& m : groups_) {
+    ++info_.buildings;
+    on_mesh_(std::move(m));
+  }
+  groups_.clear();
+}
+
+}  // namespace ogr_detail
+
+void read_ogr(const std::string& path, const OgrInputOptions& options, const std::function<void()>& source_srs_ready,
+              const std::function<void(Mesh&&)>& on_mesh, std::vector<Problem>& problems, OgrInfo& info) {
+  info = OgrInfo{};
+  ogr_detail::Source src;
+  ogr_detail::open_source(path, options, src, problems, info);
+  if (source_srs_ready) source_srs_ready();
+  ogr_detail::FeatureReader reader(path, options, src, on_mesh, problems, info);
+  GDALDataset* ds = src.ds.get();
   if (ds->TestCapability(ODsCRandomLayerRead) && options.sql.empty()) {
     // OSM and other interleaved formats: features come in file order from any layer.
     std::unordered_map<OGRLayer*, LayerPlan*> wanted;
-    for (LayerPlan& p : plans) wanted[p.layer] = &p;
+    for (LayerPlan& p : src.plans) wanted[p.layer] = &p;
     ds->ResetReading();
     for (;;) {
       OGRLayer* from = nullptr;
@@ -476,24 +516,21 @@ void read_ogr(const std::string& path, const OgrInputOptions& options, const std
       if (!feature) break;
       auto it = wanted.find(from);
       if (it == wanted.end()) continue;
-      read_feature(*it->second, *feature);
+      reader.read(*it->second, *feature);
     }
-    layer_stopped(plans.front());
+    reader.layer_stopped(src.plans.front());
   } else {
-    for (LayerPlan& p : plans) {
+    for (LayerPlan& p : src.plans) {
       p.layer->ResetReading();
       for (;;) {
         std::unique_ptr<OGRFeature> feature(p.layer->GetNextFeature());
         if (!feature) break;
-        read_feature(p, *feature);
+        reader.read(p, *feature);
       }
-      layer_stopped(p);
+      reader.layer_stopped(p);
     }
   }
-  for (Mesh& m : groups) {
-    ++info.buildings;
-    on_mesh(std::move(m));
-  }
+  reader.deliver_groups();
 }
 
 }  // namespace groundplan::gis

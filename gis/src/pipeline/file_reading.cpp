@@ -7,6 +7,7 @@
 
 #include <groundplan/error.h>
 #include <groundplan/gis/citygml_chunks.h>
+#include <groundplan/gis/ogr_ranges.h>
 #include <groundplan/gis/reader.h>
 
 #include <cpl_vsi.h>
@@ -19,6 +20,7 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <unordered_set>
@@ -304,82 +306,134 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
   return out;
 }
 
-/// The chunks of `plan` side by side; nullopt (and `why`) when they do not read the file as
-/// read_whole does.
-std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkPlan& plan,
-                                    const PipelineOptions& options, const ReadContext& context, ByteProgress& bytes,
-                                    std::string& why) {
-  const std::size_t n = plan.ranges.size();
-  std::vector<Part> parts(n);
-  std::vector<SourceInfo> infos(n);
-  std::vector<CityGmlChunkWatch> watches(n);
-  std::vector<std::unique_ptr<Placer>> placers(n);
-  std::vector<std::optional<std::string>> frame_srs(n);  // what each chunk's frame was made from, if it made one
+/// The parts of one file (CityGML chunks, OGR feature ranges) read side by side, each into its Part,
+/// georeferenced as the whole-file reading does.
+struct SideBySide {
+  std::vector<Part> parts;
+  std::vector<std::unique_ptr<Placer>> placers;
+  const Placer* first = nullptr;  // the part whose frame stands for the file's
+};
+
+/// Reads part k: its meshes to on_mesh, its problems to problems. Throws to say the parts are not the
+/// whole-file reading.
+using ReadPart = std::function<void(std::size_t k, const std::function<void(Mesh&&)>& on_mesh, std::vector<Problem>& problems)>;
+
+/// Reads the parts (one per entry of `infos`, where each part's reader keeps what it learns: the srsName
+/// read so far, the format's CRS) side by side; empty, or why they do not read the file as read_whole does.
+std::string read_side_by_side(const std::string& file, const PipelineOptions& options, const ReadContext& context,
+                              std::vector<ReadInfo>& infos, const ReadPart& read_part, SideBySide& s) {
+  const std::size_t n = infos.size();
+  s.parts.assign(n, Part{});
+  s.placers.resize(n);
+  std::vector<std::optional<std::string>> frame_srs(n);  // what each part's frame was made from, if it made one
   tbb::enumerable_thread_specific<Placer::Kept> kept;
   std::vector<std::string> errors(n);
-  CityGmlOptions citygml;
-  citygml.lod = options.lod;
-  citygml.on_bytes = [&bytes](std::uint64_t b) { bytes.add(b); };
   const bool in_working_crs = false;
   std::atomic<bool> failed{false};
-  auto read_chunk = [&](std::size_t k, std::optional<std::array<double, 2>> decision, bool keep) {
+  auto read_one = [&](std::size_t k, std::optional<std::array<double, 2>> decision, bool keep) {
     if (failed.load(std::memory_order_relaxed)) return;
-    placers[k] = std::make_unique<Placer>(file, options, context, in_working_crs, infos[k], decision,
-                                          keep ? &kept.local() : nullptr);
-    FootprintMaker maker(options, false);  // the chunks keep every core busy already
+    s.placers[k] = std::make_unique<Placer>(file, options, context, in_working_crs, infos[k].citygml, decision,
+                                            keep ? &kept.local() : nullptr, &infos[k]);
+    FootprintMaker maker(options, false);  // the parts keep every core busy already
     try {
-      read_citygml_chunk(file, plan, k, citygml, [&](Mesh&& mesh) {
-        if (placers[k]->place(mesh, parts[k])) maker.add(std::move(mesh), parts[k]);
-      }, parts[k].problems, infos[k], watches[k]);
+      read_part(k, [&](Mesh&& mesh) {
+        if (s.placers[k]->place(mesh, s.parts[k])) maker.add(std::move(mesh), s.parts[k]);
+      }, s.parts[k].problems);
     } catch (const Cancelled&) {
       throw;
     } catch (const std::exception& e) {
       errors[k] = e.what();
       failed = true;
     }
-    if (placers[k]->frame) frame_srs[k] = placers[k]->frame_srs;
-    if (keep) placers[k].reset();  // its frame goes back to the thread for its next chunk
+    if (s.placers[k]->frame) frame_srs[k] = s.placers[k]->frame_srs;
+    if (keep) s.placers[k].reset();  // its frame goes back to the thread for its next part
   };
-  // The chunks before the first placed building, one by one: that building may fix the working CRS
-  // (the UTM zone of its centre), which every chunk after it must use as the whole-file reading does.
+  // The parts before the first placed building, one by one: that building may fix the working CRS
+  // (the UTM zone of its centre), which every part after it must use as the whole-file reading does.
   std::size_t k = 0;
-  const Placer* first = nullptr;  // the chunk whose frame stands for the file's
   while (k < n && !failed) {
-    read_chunk(k, {}, false);
-    const Placer& p = *placers[k++];
-    if (p.frame && !first) first = &p;
+    read_one(k, {}, false);
+    const Placer& p = *s.placers[k++];
+    if (p.frame && !s.first) s.first = &p;
     if (p.frame && p.frame->decided()) {
-      first = &p;
+      s.first = &p;
       break;
     }
   }
-  const std::optional<std::array<double, 2>> decision = first ? first->decided_at : std::nullopt;
+  const std::optional<std::array<double, 2>> decision = s.first ? s.first->decided_at : std::nullopt;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(k, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) read_chunk(i, decision, true);
+    for (std::size_t i = r.begin(); i != r.end(); ++i) read_one(i, decision, true);
   }, tbb::simple_partitioner());
   for (std::size_t i = 0; i < n; ++i)
-    if (!errors[i].empty()) {
-      why = "chunk " + std::to_string(i + 1) + " of " + std::to_string(n) + ": " + errors[i];
-      return std::nullopt;
-    }
+    if (!errors[i].empty()) return "part " + std::to_string(i + 1) + " of " + std::to_string(n) + ": " + errors[i];
   for (std::size_t i = 0; i < n; ++i)
-    if (first && frame_srs[i] && *frame_srs[i] != first->frame_srs) {
-      why = "the srsName before the first building differs between chunks";
-      return std::nullopt;
-    }
+    if (s.first && frame_srs[i] && *frame_srs[i] != s.first->frame_srs)
+      return "the source CRS before the first building differs between parts";
+  return {};
+}
+
+/// The chunks of `plan` side by side; nullopt (and `why`) when they do not read the file as
+/// read_whole does.
+std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkPlan& plan,
+                                    const PipelineOptions& options, const ReadContext& context, ByteProgress& bytes,
+                                    std::string& why) {
+  const std::size_t n = plan.ranges.size();
+  std::vector<ReadInfo> infos(n);
+  std::vector<CityGmlChunkWatch> watches(n);
+  CityGmlOptions citygml;
+  citygml.lod = options.lod;
+  citygml.on_bytes = [&bytes](std::uint64_t b) { bytes.add(b); };
+  SideBySide s;
+  why = read_side_by_side(file, options, context, infos, [&](std::size_t k, const auto& on_mesh, auto& problems) {
+    read_citygml_chunk(file, plan, k, citygml, on_mesh, problems, infos[k].citygml, watches[k]);
+  }, s);
+  if (!why.empty()) return std::nullopt;
+  std::vector<SourceInfo> sources(n);
+  for (std::size_t k = 0; k < n; ++k) sources[k] = infos[k].citygml;
   SourceInfo merged;
   std::vector<Problem> file_problems;
-  why = merge_citygml_chunks(file, plan, infos, watches, merged, file_problems);
+  why = merge_citygml_chunks(file, plan, sources, watches, merged, file_problems);
   if (!why.empty()) return std::nullopt;
 
   FileRead out;
   Delivered delivered;
-  for (Part& part : parts) append(part, file, out, delivered);
+  for (Part& part : s.parts) append(part, file, out, delivered);
   out.problems.insert(out.problems.end(), file_problems.begin(), file_problems.end());
   ReadInfo info;
   info.citygml = merged;
   info.format = InputFormat::CityGml;
-  finish_file(out, delivered, info, first ? first->frame.get() : nullptr, file, options);
+  finish_file(out, delivered, info, s.first ? s.first->frame.get() : nullptr, file, options);
+  out.chunks = n;
+  return out;
+}
+
+/// The feature ranges of `plan` side by side; nullopt (and `why`) when they do not read the source as
+/// read_whole does.
+std::optional<FileRead> read_ogr_ranges(const std::string& file, const OgrRangePlan& plan,
+                                        const PipelineOptions& options, const ReadContext& context, ByteProgress& bytes,
+                                        std::string& why) {
+  const std::size_t n = plan.ranges.size();
+  std::vector<ReadInfo> infos(n);
+  for (ReadInfo& info : infos) {  // what read_any says of the source before its first mesh
+    info.format = InputFormat::Ogr;
+    info.source_srs = plan.source_srs;
+    info.source_axis = plan.east_north ? AxisOrder::EastNorth : AxisOrder::NorthEast;
+  }
+  std::vector<OgrRangeWatch> watches(n);
+  SideBySide s;
+  why = read_side_by_side(file, options, context, infos, [&](std::size_t k, const auto& on_mesh, auto& problems) {
+    read_ogr_range(file, options.ogr_input, plan, k, on_mesh, problems, watches[k]);
+  }, s);
+  if (why.empty()) why = check_ogr_ranges(plan, watches);
+  if (!why.empty()) return std::nullopt;
+
+  FileRead out;
+  out.problems = plan.head;  // the whole reading says them before its first feature
+  Delivered delivered;
+  for (Part& part : s.parts) append(part, file, out, delivered);
+  VSIStatBufL st;
+  if (VSIStatL(file.c_str(), &st) == 0) bytes.add(static_cast<std::uint64_t>(st.st_size));
+  finish_file(out, delivered, infos.front(), s.first ? s.first->frame.get() : nullptr, file, options);
   out.chunks = n;
   return out;
 }
@@ -424,6 +478,20 @@ FileRead read_file(const std::string& file, const PipelineOptions& options, cons
           whole_reason = e.what();  // read_whole says it again, as a problem of the file
         }
       }
+    }
+  }
+  const bool may_range = options.read_chunk_bytes >= 0 && options.read_range_features >= 0 &&
+                         (options.read_range_features > 0 || threads > 1);
+  if (may_range && detect_format(file) == InputFormat::Unknown && ogr_can_read(file)) {
+    try {
+      const OgrRangePlan plan = plan_ogr_ranges(file, options.ogr_input, options.read_range_features, threads);
+      whole_reason = plan.why_not;
+      if (plan.ranges.size() >= 2) {
+        std::optional<FileRead> ranged = read_ogr_ranges(file, plan, options, context, bytes, whole_reason);
+        if (ranged) return std::move(*ranged);
+      }
+    } catch (const InputError& e) {
+      whole_reason = e.what();  // read_whole says it again, as a problem of the file
     }
   }
   FileRead out = read_whole(file, options, context, bytes);

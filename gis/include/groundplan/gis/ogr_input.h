@@ -14,6 +14,9 @@
 // huge coordinates: a Problem naming the layer and the FID; the rest of the layer goes on. Invalid
 // polygons (self-crossing rings) pass as they are.
 //
+// A layer with several geometry fields (SQLite, PostGIS, CSV with GEOM_POSSIBLE_NAMES ...): one is read,
+// the one geom_field names, else the first; a NOTE names the ones left out. Its CRS is the layer's.
+//
 // Coordinates come in the layer's data axis order (GDAL's traditional GIS order: x = longitude or
 // easting) and in ONE source CRS per file: the first selected layer's; other layers in another CRS are
 // transformed into it by GDAL. The caller turns that CRS into the working frame (ReadInfo::source_srs).
@@ -38,6 +41,7 @@ struct OgrInputOptions {
   std::vector<std::string> open_options;  // --input-oo / INPUT_OO: NAME=VALUE open options of the source's driver
   std::string id_field;                   // --id-field / ID_FIELD: building id; empty = the FID
   std::string group_by;                   // --group-by / GROUP_BY: features sharing this field's value are one building
+  std::string geom_field;                 // --input-geom-field / INPUT_GEOM_FIELD: the geometry field read; empty = the first
   std::size_t max_vertices = 50'000'000;  // a feature with more vertices is a Problem TOO_MANY_VERTICES
   double max_abs_coordinate = 1e9;        // as CityGmlOptions: beyond it a feature is COORDINATE_OUT_OF_RANGE
 };

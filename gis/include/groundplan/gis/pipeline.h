@@ -36,16 +36,21 @@ struct PipelineOptions {
   /// CityGML files are cut into chunks of about this many bytes, read side by side (issue 14): 0 = automatic
   /// (about four chunks a thread, 2-64 MiB; never with one thread), < 0 = never. The result is the same either way.
   std::int64_t read_chunk_bytes = 0;
+  /// OGR sources are cut into ranges of about this many features, read side by side, one dataset handle each
+  /// (issue 22, gis/ogr_ranges.h): 0 = automatic (about four ranges a thread, at least 20000 features; never with
+  /// one thread), < 0 = never; read_chunk_bytes < 0 also means never. The result is the same either way.
+  std::int64_t read_range_features = 0;
 };
 
 /// How the inputs were read (--stats "reading").
 struct ReadStats {
   std::size_t files = 0;
   std::size_t threads = 0;          // threads the run used
-  std::size_t files_chunked = 0;    // CityGML files read in chunks side by side
-  std::size_t chunks = 0;           // their chunks
+  std::size_t files_chunked = 0;    // CityGML files read in chunks, OGR sources in feature ranges, side by side
+  std::size_t chunks = 0;           // their chunks and ranges
   std::uint64_t bytes = 0;          // bytes of all input files
-  /// CityGML files read whole although cutting was allowed, and why (small files are not listed).
+  /// CityGML files and OGR sources read whole although cutting was allowed, and why (small files are not listed;
+  /// OGR sources are, where a flag or the driver rules ranges out).
   std::vector<std::pair<std::string, std::string>> read_whole;
 };
 
