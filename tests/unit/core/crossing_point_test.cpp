@@ -5,6 +5,7 @@
 // (tests/corpus/fuzz-regressions/union/plans-overlap-self-intersecting-*).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 
@@ -105,6 +106,18 @@ TEST(CrossingPoint, CorrectlyRounded) {
   mpfr_clear(n);
   EXPECT_GT(crossings, 10000);
   EXPECT_EQ(wrong, 0) << "coordinates not correctly rounded, of " << crossings << " crossings";
+}
+
+/// An exact crossing halfway between two doubles rounds to the even one (the long-double bound cannot
+/// decide a tie, so this goes through the exact MPFR path).
+TEST(CrossingPoint, TiesGoToEven) {
+  const double u = std::ldexp(1.0, -52);
+  // a->b crosses the x axis at x = 1 + u/2 (halfway between 1 and 1 + u): even is 1
+  EXPECT_EQ(robust::crossing_point({1, -1}, {1 + u, 1}, {0, 0}, {4, 0}).x, 1.0);
+  // at x = 1 + 3u/2 (halfway between 1 + u and 1 + 2u): even is 1 + 2u
+  EXPECT_EQ(robust::crossing_point({1 + u, -1}, {1 + 2 * u, 1}, {0, 0}, {4, 0}).x, 1 + 2 * u);
+  // the same in y, operands swapped
+  EXPECT_EQ(robust::crossing_point({0, 0}, {0, 4}, {-1, 1 + u}, {1, 1 + 2 * u}).y, 1 + 2 * u);
 }
 
 }  // namespace
