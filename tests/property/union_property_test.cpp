@@ -10,6 +10,7 @@
 
 #include "robust/predicates.h"
 
+#include "near_touch.h"
 #include "union_generators.h"
 #include "union_test_util.h"
 
@@ -29,17 +30,24 @@ using testing::Family;
 // points, which does not depend on GEOS. Counts there are reported only. In every family, when
 // counts, areas and validity agree but GEOS's SymDifference does not (it can fail on near-coincident
 // rounded vertices: UnionRegression.GeosSymDifferenceImplausibleSeed6000910), point sampling
-// decides; the summary line counts how often.
+// decides; the summary line counts how often. Near-touching output vertices (two distinct vertices
+// within 8 ulps, or a vertex that close to an edge it is not on) fail every family but the two named
+// in near_touch_open, where they are counted (issue 20).
 class UnionProperty : public ::testing::TestWithParam<Family> {};
 
 using testing::sampling_disagreements;
 
 constexpr int kCasesPerFamily = 1000;
 
+// Families whose output may still hold near-touch artefacts (issue 20, measured 2026-11-24 on branch
+// snap-round, 1000 cases each): near_collinear 679 (walls an ulp apart by construction), large_offsets
+// 13 (millimetre features at 1e7: vertices one ulp apart). Every other family has none, and fails on one.
+bool near_touch_open(Family f) { return f == Family::NearCollinear || f == Family::LargeOffsets; }
+
 TEST_P(UnionProperty, MatchesGeos) {
   const Family fam = GetParam();
   const auto oracle = fam == Family::NearCollinear ? testing::Oracle::AreaAndValid : testing::Oracle::Strict;
-  int failures = 0, count_mismatch = 0, geos_inconsistent = 0, symdiff_fallback = 0;
+  int failures = 0, count_mismatch = 0, geos_inconsistent = 0, symdiff_fallback = 0, near_touching = 0;
   for (int i = 0; i < kCasesPerFamily && failures < 3; ++i) {
     const std::uint64_t seed = 1000003ull * (static_cast<std::uint64_t>(fam) + 1) + static_cast<std::uint64_t>(i);
     testing::Rng rng(seed);
@@ -53,6 +61,16 @@ TEST_P(UnionProperty, MatchesGeos) {
       c.ok = bad == 0;
       if (!c.ok) c.message += "\nsampling oracle: " + std::to_string(bad) + " of 4000 points disagree";
     }
+    // Near-touch artefacts (tests/support/near_touch.h, issue 20): a failure in every family but the
+    // two where they are still open (snap rounding, docs/union_engine.md): counted there.
+    const testing::NearTouch nt = testing::near_touch(c.plans);
+    if (nt.pairs) {
+      ++near_touching;
+      if (!near_touch_open(fam)) {
+        c.ok = false;
+        c.message = "near-touching output: " + nt.first + "\n" + c.message;
+      }
+    }
     if (!c.ok) {
       ++failures;
       ADD_FAILURE() << testing::family_name(fam) << " seed " << seed << ": " << c.message;
@@ -61,7 +79,8 @@ TEST_P(UnionProperty, MatchesGeos) {
   RecordProperty("count_mismatches", count_mismatch);
   std::cout << "[ " << testing::family_name(fam) << " ] " << kCasesPerFamily << " cases, polygon/hole count differs from GEOS in "
             << count_mismatch << ", GEOS not a fixed point of its own union in " << geos_inconsistent
-            << ", GEOS symmetric difference implausible (decided by sampling) in " << symdiff_fallback << "\n";
+            << ", GEOS symmetric difference implausible (decided by sampling) in " << symdiff_fallback
+            << ", near-touching output vertices in " << near_touching << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Families, UnionProperty, ::testing::ValuesIn(testing::kAllFamilies),

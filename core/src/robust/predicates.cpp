@@ -6,6 +6,7 @@
 #include <mpfr.h>
 
 #include <algorithm>
+#include <limits>
 #include <utility>
 #include <cmath>
 
@@ -354,13 +355,82 @@ std::vector<std::size_t> nearest_crossings(const Point2& a, const Point2& b, con
   return s;
 }
 
+namespace {
+
+/// The exact crossing coordinate a.c + oa (b.c - a.c) / (oa - ob), correctly rounded to the nearest
+/// double (ties to even), computed exactly in MPFR. Every operation is checked exact through its
+/// ternary value; precision is raised until it is. Only the final division rounds, once.
+struct MpCrossing {
+  mpfr_prec_t prec = 0;
+  mpfr_t fx, fy, ax, ay, bx, by, t1, t2, oa, ob, d, dc, num, r53;
+  void make(mpfr_prec_t p) {
+    if (prec != 0) clear();
+    prec = p;
+    for (mpfr_ptr v : {fx, fy, ax, ay, bx, by, t1, t2, oa, ob, d, dc, num}) mpfr_init2(v, p);
+    mpfr_init2(r53, 53);
+  }
+  void clear() {
+    for (mpfr_ptr v : {fx, fy, ax, ay, bx, by, t1, t2, oa, ob, d, dc, num, r53}) mpfr_clear(v);
+    prec = 0;
+  }
+  ~MpCrossing() {
+    if (prec != 0) clear();
+  }
+  /// Returns false when some step was inexact at this precision.
+  bool run(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1, Point2& out) {
+    int inexact = 0;
+    inexact |= mpfr_set_d(fx, f1.x, MPFR_RNDN) | mpfr_sub_d(fx, fx, f0.x, MPFR_RNDN);
+    inexact |= mpfr_set_d(fy, f1.y, MPFR_RNDN) | mpfr_sub_d(fy, fy, f0.y, MPFR_RNDN);
+    inexact |= mpfr_set_d(ax, a.x, MPFR_RNDN) | mpfr_sub_d(ax, ax, f0.x, MPFR_RNDN);
+    inexact |= mpfr_set_d(ay, a.y, MPFR_RNDN) | mpfr_sub_d(ay, ay, f0.y, MPFR_RNDN);
+    inexact |= mpfr_set_d(bx, b.x, MPFR_RNDN) | mpfr_sub_d(bx, bx, f0.x, MPFR_RNDN);
+    inexact |= mpfr_set_d(by, b.y, MPFR_RNDN) | mpfr_sub_d(by, by, f0.y, MPFR_RNDN);
+    inexact |= mpfr_mul(t1, fx, ay, MPFR_RNDN) | mpfr_mul(t2, fy, ax, MPFR_RNDN) | mpfr_sub(oa, t1, t2, MPFR_RNDN);
+    inexact |= mpfr_mul(t1, fx, by, MPFR_RNDN) | mpfr_mul(t2, fy, bx, MPFR_RNDN) | mpfr_sub(ob, t1, t2, MPFR_RNDN);
+    inexact |= mpfr_sub(d, oa, ob, MPFR_RNDN);
+    if (inexact != 0) return false;
+    if (mpfr_zero_p(d)) return false;  // not a proper crossing: the caller keeps its double estimate
+    double* const c_out[2] = {&out.x, &out.y};
+    const double c_a[2] = {a.x, a.y}, c_b[2] = {b.x, b.y};
+    for (int k = 0; k < 2; ++k) {
+      // c = (a.c * d + oa * (b.c - a.c)) / d
+      inexact |= mpfr_set_d(dc, c_b[k], MPFR_RNDN) | mpfr_sub_d(dc, dc, c_a[k], MPFR_RNDN);
+      inexact |= mpfr_mul(t1, oa, dc, MPFR_RNDN) | mpfr_mul_d(t2, d, c_a[k], MPFR_RNDN);
+      inexact |= mpfr_add(num, t1, t2, MPFR_RNDN);
+      if (inexact != 0) return false;
+      mpfr_div(r53, num, d, MPFR_RNDN);
+      *c_out[k] = mpfr_get_d(r53, MPFR_RNDN);
+    }
+    return true;
+  }
+};
+
+thread_local MpCrossing t_mp_crossing;
+
+/// Long-double estimate of one coordinate with a certified error bound: returns true and the
+/// correctly rounded double when the whole interval [estimate - bound, estimate + bound], which
+/// contains the exact value, rounds to one double.
+template <class L>
+bool certain_round(L est, L bound, double& out) {
+  const L lo = std::nextafter(est - bound, -std::numeric_limits<L>::infinity());
+  const L hi = std::nextafter(est + bound, std::numeric_limits<L>::infinity());
+  const double dlo = static_cast<double>(lo), dhi = static_cast<double>(hi);
+  if (dlo != dhi) return false;
+  out = dlo;
+  return true;
+}
+
+}  // namespace
+
 Point2 crossing_point(const Point2& a_in, const Point2& b_in, const Point2& f0_in, const Point2& f1_in) {
-  // One crossing, one rounding (issue 20): the walk meets a crossing of edges e and f once along e
-  // and once along f, in either direction, and each time asks for its point. Rounding the same
-  // arithmetic in another operand order gave two doubles a few ulps apart (micro-edges, pieces
-  // joined by a zero-width gap, slivers of overlap between plans). So the operands are put in one
-  // canonical order first: each segment from its lexicographically smaller end, the smaller segment
-  // first. The point is then a function of the two segments alone.
+  // One crossing, one rounding (issue 20). The point is the EXACT crossing rounded to the nearest
+  // double in each coordinate (correct rounding), so it is a function of the exact point alone: the
+  // same crossing met along any of its edges, in either direction, and a crossing where three or
+  // more edges meet (every pair of them has the same exact point), all give the same double point.
+  // (Before: the long-double arithmetic of each pair was rounded on its own; the canonical operand
+  // order below fixed the first, not the second: union-open a676fee0, three edges through one
+  // crossing, plans overlapping next to two output vertices one ulp apart.) Fast path: long double
+  // with a certified error bound, used when the bound's interval rounds to one double; else MPFR.
   auto less = [](const Point2& p, const Point2& q) { return p.x < q.x || (p.x == q.x && p.y < q.y); };
   Point2 a = a_in, b = b_in, f0 = f0_in, f1 = f1_in;
   if (less(b, a)) std::swap(a, b);
@@ -370,12 +440,44 @@ Point2 crossing_point(const Point2& a_in, const Point2& b_in, const Point2& f0_i
     std::swap(b, f1);
   }
   using L = long double;
+  constexpr L u = std::numeric_limits<L>::epsilon() / 2;  // unit roundoff of long double
   const L fx = L(f1.x) - L(f0.x), fy = L(f1.y) - L(f0.y);
-  const L oa = fx * (L(a.y) - L(f0.y)) - fy * (L(a.x) - L(f0.x));
-  const L ob = fx * (L(b.y) - L(f0.y)) - fy * (L(b.x) - L(f0.x));
-  const L t = oa / (oa - ob);
+  const L ax = L(a.x) - L(f0.x), ay = L(a.y) - L(f0.y);
+  const L bx = L(b.x) - L(f0.x), by = L(b.y) - L(f0.y);
+  const L oa = fx * ay - fy * ax;
+  const L ob = fx * by - fy * bx;
+  const L ma = std::fabs(fx * ay) + std::fabs(fy * ax), mb = std::fabs(fx * by) + std::fabs(fy * bx);
+  // |oa - exact| <= 4u ma (+ higher order); doubled for those and for rounding of the bounds.
+  const L ea = 8 * u * ma, eb = 8 * u * mb;
+  const L d = oa - ob;
+  const L ed = ea + eb + 2 * u * (ma + mb);
+  const L t = oa / d;
   Point2 p{static_cast<double>(L(a.x) + t * (L(b.x) - L(a.x))), static_cast<double>(L(a.y) + t * (L(b.y) - L(a.y)))};
-  // The exact point lies in both segments' bounding boxes: clamp into their intersection.
+  bool certain = false;
+  if (std::isfinite(t) && std::fabs(d) > 2 * ed) {
+    // |t - exact t| <= (|oa| ed + |d| ea) / (|d| (|d| - ed)) + u |t|
+    const L et = 2 * ((std::fabs(oa) * ed + std::fabs(d) * ea) / (std::fabs(d) * (std::fabs(d) - ed)) + u * std::fabs(t));
+    const L dx = L(b.x) - L(a.x), dy = L(b.y) - L(a.y);
+    const L x = L(a.x) + t * dx, y = L(a.y) + t * dy;
+    const L ex = 2 * (et * std::fabs(dx) + 3 * u * std::fabs(t * dx) + 2 * u * std::fabs(x));
+    const L ey = 2 * (et * std::fabs(dy) + 3 * u * std::fabs(t * dy) + 2 * u * std::fabs(y));
+    Point2 q;
+    certain = certain_round(x, ex, q.x) && certain_round(y, ey, q.y);
+    if (certain) p = q;
+  }
+  if (!certain) {
+    MpCrossing& M = t_mp_crossing;
+    Point2 q = p;
+    for (mpfr_prec_t prec : {mpfr_prec_t{512}, mpfr_prec_t{2400}, mpfr_prec_t{9000}, mpfr_prec_t{36000}}) {
+      if (M.prec < prec) M.make(prec);
+      if (M.run(a, b, f0, f1, q)) {
+        p = q;
+        break;
+      }
+    }
+  }
+  // The exact point lies in both segments' bounding boxes, and so does its correct rounding; the
+  // clamp only matters for a caller that breaks the precondition (no proper crossing).
   const double xlo = std::max(std::min(a.x, b.x), std::min(f0.x, f1.x));
   const double xhi = std::min(std::max(a.x, b.x), std::max(f0.x, f1.x));
   const double ylo = std::max(std::min(a.y, b.y), std::min(f0.y, f1.y));

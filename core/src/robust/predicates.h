@@ -77,10 +77,11 @@ struct Segment {
 /// longer separate go to compare_crossings, which escalates on its own.
 std::vector<std::size_t> nearest_crossings(const Point2& a, const Point2& b, const std::vector<Segment>& segs);
 
-/// The crossing point of segment a->b with the line f0->f1 (precondition: proper crossing), rounded
-/// to doubles (computed in long double, then clamped into the common bounding box of both segments,
-/// which contains the exact point). The result depends only on the two segments, not on their
-/// order or directions: one crossing is always rounded to the same point (issue 20).
+/// The crossing point of segment a->b with the line f0->f1 (precondition: proper crossing): the exact
+/// point correctly rounded to the nearest double in each coordinate (long double with a certified
+/// error bound; MPFR when the bound cannot decide). The result is a function of the exact point
+/// alone: one crossing, met along any pair of the edges through it, in any order or direction, is
+/// always the same double point (issue 20).
 Point2 crossing_point(const Point2& a, const Point2& b, const Point2& f0, const Point2& f1);
 
 }  // namespace groundplan::robust

@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: MIT
+// Ring builder (see ring_builder.h). Moved out of block_union.cpp.
+#include "union/ring_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <unordered_map>
+
+#include "robust/predicates.h"
+#include "union/output_rounding.h"
+
+namespace groundplan::detail {
+
+using robust::orient;
+
+/// Splits a closed walk at repeated (rounded) vertices into simple rings; drops collapsed parts.
+/// `rounded`: the walk has rounded crossing points. Only then can a ring of rounding-scale area be a
+/// collapsed sliver; a ring of exact input vertices is part of the exact union whatever its size
+/// (a 1e-9 m² gap between neighbours one ulp apart is a real hole of the input).
+void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point2>>& out, bool rounded) {
+  std::vector<Point2> pts;
+  for (const Point2& p : walk)
+    if (pts.empty() || !(pts.back() == p)) pts.push_back(p);
+  while (pts.size() > 1 && pts.front() == pts.back()) pts.pop_back();
+  struct H {
+    std::size_t operator()(const Point2& p) const {
+      std::uint64_t a, b;
+      std::memcpy(&a, &p.x, 8);
+      std::memcpy(&b, &p.y, 8);
+      return std::hash<std::uint64_t>()(a * 0x9E3779B97F4A7C15ull ^ b);
+    }
+  };
+  std::vector<Point2> stack;
+  auto emit = [&](std::vector<Point2> r) {
+    // remove spikes a-b-a left by rounding
+    bool changed = true;
+    while (changed && r.size() >= 3) {
+      changed = false;
+      for (std::size_t i = 0; i < r.size() && r.size() >= 3; ++i) {
+        const std::size_t n = r.size();
+        if (r[(i + n - 1) % n] == r[(i + 1) % n]) {
+          const std::size_t hi = std::max(i, (i + 1) % n), lo = std::min(i, (i + 1) % n);
+          r.erase(r.begin() + static_cast<std::ptrdiff_t>(hi));
+          r.erase(r.begin() + static_cast<std::ptrdiff_t>(lo));
+          changed = true;
+          break;
+        }
+      }
+    }
+    // drop vertices where the ring goes straight on (exactly collinear, same direction)
+    if (r.size() >= 3) {
+      std::vector<Point2> k;
+      k.reserve(r.size());
+      const std::size_t n = r.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Point2& a = r[(i + n - 1) % n];
+        const Point2& b = r[i];
+        const Point2& c = r[(i + 1) % n];
+        if (orient(a, b, c) == 0 && same_way(a, b, b, c)) continue;
+        k.push_back(b);
+      }
+      r.swap(k);
+    }
+    // a ring whose area is at rounding scale is a collapsed sliver (a gap or overlap between
+    // walls that coincide up to rounding): it has no area to give
+    if (rounded && r.size() >= 3) {
+      long double a2 = 0, per = 0;
+      double scale = 0;
+      for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+        const Point2& a = r[i];
+        const Point2& b = r[(i + 1) % n];
+        a2 += (static_cast<long double>(a.x) - r[0].x) * (static_cast<long double>(b.y) - r[0].y) -
+              (static_cast<long double>(b.x) - r[0].x) * (static_cast<long double>(a.y) - r[0].y);
+        per += std::hypot(static_cast<long double>(b.x) - a.x, static_cast<long double>(b.y) - a.y);
+        scale = std::max(scale, rounding_scale({a}));
+      }
+      if (std::fabs(a2) / 2 <= per * scale) r.clear();
+    }
+    if (r.size() >= 3) out.push_back(std::move(r));
+  };
+  {
+    // the common case: no vertex repeats, so the walk is one simple ring
+    std::vector<Point2> sorted(pts);
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) {
+      emit(std::move(pts));
+      return;
+    }
+  }
+  std::unordered_map<Point2, std::size_t, H> pos;
+  for (const Point2& p : pts) {
+    auto it = pos.find(p);
+    if (it != pos.end()) {
+      const std::size_t k = it->second;
+      std::vector<Point2> sub(stack.begin() + static_cast<std::ptrdiff_t>(k), stack.end());
+      for (std::size_t i = k + 1; i < stack.size(); ++i) pos.erase(stack[i]);
+      stack.resize(k + 1);
+      emit(std::move(sub));
+    } else {
+      pos.emplace(p, stack.size());
+      stack.push_back(p);
+    }
+  }
+  emit(std::move(stack));
+}
+
+void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>& polys_,
+                    const std::vector<Edge>& edges_, BlockStats& stats_, BlockResult& out) {
+  struct R {
+    std::vector<Point2> pts;
+    std::size_t src;  // index into rings_
+    Box box;
+    long double area2;
+  };
+  std::vector<R> outers, holes;
+  for (std::size_t i = 0; i < rings_.size(); ++i) {
+    std::vector<std::vector<Point2>> parts;
+    std::vector<Point2> w;
+    for (const Point2& p : rings_[i].pts)
+      if (w.empty() || !(w.back() == p)) w.push_back(p);
+    while (w.size() > 1 && w.front() == w.back()) w.pop_back();
+    if (rings_[i].rounded && !node_walk(w))
+      out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                     "a boundary crosses itself after rounding by more than rounding error"});
+    split_simple(w, parts, rings_[i].rounded);
+    for (auto& p : parts) {
+      const int o = ring_orientation(p);
+      if (o == 0) continue;
+      R r{std::move(p), i, Box{}, 0};
+      for (const Point2& q : r.pts) r.box.add(q);
+      r.area2 = signed_area2(r.pts);
+      (o > 0 ? outers : holes).push_back(std::move(r));
+    }
+  }
+  // innermost outer ring containing p (by a vertex not on its boundary)
+  auto locate = [&](const std::vector<Point2>& pts, std::size_t skip_outer) -> std::size_t {
+    std::size_t best = outers.size();
+    for (std::size_t k = 0; k < outers.size(); ++k) {
+      if (k == skip_outer) continue;
+      const R& o = outers[k];
+      int inside = 0;
+      for (const Point2& p : pts) {
+        if (!o.box.contains(p)) {
+          inside = -1;
+          break;
+        }
+        inside = point_in_ring(p, o.pts);
+        if (inside != 0) break;
+      }
+      if (inside > 0 && (best == outers.size() || std::fabs(o.area2) < std::fabs(outers[best].area2))) best = k;
+    }
+    return best;
+  };
+  std::vector<std::vector<std::size_t>> holes_of(outers.size());
+  for (std::size_t h = 0; h < holes.size(); ++h) {
+    const std::size_t k = locate(holes[h].pts, outers.size());
+    if (k == outers.size()) {
+      out.problems.push_back(Problem{"", "", "union", "ORPHAN_HOLE",
+                                     "a hole of the union was found outside every outer ring and was dropped"});
+      continue;
+    }
+    holes_of[k].push_back(h);
+  }
+  std::vector<std::vector<std::uint32_t>> polys_of(outers.size());
+  std::vector<char> poly_seen(polys_.size(), 0);
+  for (std::size_t k = 0; k < outers.size(); ++k) {
+    auto add = [&](std::size_t src) {
+      for (std::uint32_t p : rings_[src].polys) {
+        polys_of[k].push_back(p);
+        poly_seen[p] = 1;
+      }
+    };
+    add(outers[k].src);
+    for (std::size_t h : holes_of[k]) add(holes[h].src);
+  }
+  // Polygons with area but no boundary piece lie inside the union: find their plan by a vertex.
+  for (std::uint32_t p = 0; p < polys_.size(); ++p) {
+    if (poly_seen[p] || !polys_[p].has_area) continue;
+    // its vertices may all lie on the union's boundary (a triangle inscribed in a square): its
+    // edges' midpoints are then inside (an unwalked edge has no boundary piece)
+    std::vector<Point2> pts;
+    for (std::uint32_t ei = polys_[p].first_edge; ei < polys_[p].end_edge && pts.size() < 8; ++ei)
+      pts.push_back(edges_[ei].p0);
+    for (std::uint32_t ei = polys_[p].first_edge; ei < polys_[p].end_edge && pts.size() < 16; ++ei)
+      pts.push_back({0.5 * (edges_[ei].p0.x + edges_[ei].p1.x), 0.5 * (edges_[ei].p0.y + edges_[ei].p1.y)});
+    const std::size_t k = locate(pts, outers.size());
+    if (k < outers.size()) polys_of[k].push_back(p);
+  }
+  for (std::size_t k = 0; k < outers.size(); ++k) {
+    GroundPlan g;
+    g.polygon.outer = std::move(outers[k].pts);
+    long double a2 = outers[k].area2;
+    for (std::size_t h : holes_of[k]) {
+      a2 += holes[h].area2;
+      g.polygon.holes.push_back(std::move(holes[h].pts));
+    }
+    // Rounded output must stay valid (issue 3): check exactly, repair rounding slivers locally.
+    // A plan whose vertices are all input vertices is the exact boundary: nothing to check.
+    bool rounded = rings_[outers[k].src].rounded;
+    for (std::size_t h : holes_of[k]) rounded |= rings_[holes[h].src].rounded;
+    if (rounded) {
+      std::vector<std::vector<Point2>*> rr{&g.polygon.outer};
+      for (Ring& h : g.polygon.holes) rr.push_back(&h);
+      Conflict c{};
+      int repairs = 0;
+      while (find_conflict(rr, c)) {
+        if (repairs >= 32 || !repair_once(rr, c)) {
+          const Point2& p = (*rr[c.ring_a])[c.edge_a % rr[c.ring_a]->size()];
+          out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                         "rounding intersection points to doubles left a self-intersection near (" +
+                                             std::to_string(p.x) + ", " + std::to_string(p.y) + ")"});
+          break;
+        }
+        ++repairs;
+        ++stats_.rounding_repairs;
+      }
+      if (repairs > 0) {
+        a2 = signed_area2(g.polygon.outer);
+        for (const Ring& h : g.polygon.holes) a2 += signed_area2(h);
+      }
+    }
+    g.area_m2 = static_cast<double>(a2 / 2);
+    for (std::uint32_t p : polys_of[k]) g.members.push_back(polys_[p].footprint);
+    std::sort(g.members.begin(), g.members.end());
+    g.members.erase(std::unique(g.members.begin(), g.members.end()), g.members.end());
+    out.plans.push_back(std::move(g));
+  }
+}
+
+}  // namespace groundplan::detail
