@@ -6,6 +6,7 @@
 #include <groundplan/gis/placement.h>
 #include <groundplan/gis/reader.h>
 
+#include <cpl_conv.h>
 #include <cpl_vsi.h>
 
 #include "cityjson/read_into.h"
@@ -154,6 +155,23 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     const std::uint64_t ratio = std::max<std::uint64_t>(1, options.gzip_max_ratio);
     max_bytes = std::max(options.gzip_min_bytes, packed > UINT64_MAX / ratio ? UINT64_MAX : packed * ratio);
   }
+  // GDAL caches a .gz's unpacked size in x.gz.properties beside it: an input is not ours to write beside.
+  struct NoGzipProperties {
+    std::string old;
+    bool had = false;
+    explicit NoGzipProperties(bool on) {
+      if (!on) return;
+      const char* v = CPLGetThreadLocalConfigOption("CPL_VSIL_GZIP_WRITE_PROPERTIES", nullptr);
+      had = v != nullptr;
+      if (v) old = v;
+      CPLSetThreadLocalConfigOption("CPL_VSIL_GZIP_WRITE_PROPERTIES", "NO");
+      set = true;
+    }
+    ~NoGzipProperties() {
+      if (set) CPLSetThreadLocalConfigOption("CPL_VSIL_GZIP_WRITE_PROPERTIES", had ? old.c_str() : nullptr);
+    }
+    bool set = false;
+  } no_properties(max_bytes != 0);
   auto too_big = [&](std::uint64_t read) {
     return InputError(path + ": unpacks to more than " + std::to_string(max_bytes) + " bytes after " +
                       std::to_string(read) + " read, over " + std::to_string(options.gzip_max_ratio) +

@@ -74,6 +74,19 @@ TEST(CompressedInput, RealSamplesGiveWhatThePlainFileGives) {
     EXPECT_EQ(a.crs_name, b.crs_name) << rel;
     EXPECT_EQ(a.problems.size(), b.problems.size()) << rel;
   }
+  // A KML whose COLLADA model lies beside it: the model is found beside the .kml.gz, not inside /vsigzip/.
+  std::filesystem::create_directories(dir.path / "kml");
+  const std::string kml = test::shared_data("kml-collada-korea-mago/sample-kml/a_bd001.kml");
+  std::filesystem::copy_file(test::shared_data("kml-collada-korea-mago/sample-kml/a_bd001.dae"), dir.path / "kml" / "a_bd001.dae");
+  write_gz((dir.path / "kml" / "a_bd001.kml.gz").string(), slurp(kml));
+  const gis::PipelineResult k = run(kml), kgz = run((dir.path / "kml" / "a_bd001.kml.gz").string());
+  ASSERT_EQ(k.footprints.size(), 1u);
+  EXPECT_EQ(test::plan_keys(k.plans), test::plan_keys(kgz.plans));
+  EXPECT_EQ(kgz.problems.size(), k.problems.size());
+  // Nothing is written beside the inputs (GDAL's x.gz.properties cache is off while reading them).
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path))
+    EXPECT_NE(e.path().extension(), ".properties") << e.path();
+
   // A folder of tiles: its .gz files found by name.
   EXPECT_EQ(run((dir.path / "bag").string()).buildings_read, 2 * run(test::shared_data("cityjson-3dbag-cjseq/3dbag_b2.city.json")).buildings_read);
 }
