@@ -283,6 +283,54 @@ bool WorkingFrame::transform(Mesh& mesh, std::string* reason) {
   return true;
 }
 
+std::string WorkingFrame::area_of_use_mismatch(double x, double y) const {
+  const Impl& m = *impl_;
+  if (!m.src_known || !m.src_h || !std::isfinite(x) || !std::isfinite(y)) return {};
+  double west = 0, south = 0, east = 0, north = 0;
+  const char* area = nullptr;
+  if (!proj_get_area_of_use(m.ctx, m.src_h.get(), &west, &south, &east, &north, &area) || west <= -1000) return {};
+  // The point as the frame reads it (transform(): swap_in, then the CRS's own order for a geographic
+  // source, easting first for a projected one) to longitude/latitude.
+  PjPtr src_in(m.src_type == PJ_TYPE_PROJECTED_CRS ? proj_normalize_for_visualization(m.ctx, m.src_h.get())
+                                                   : proj_clone(m.ctx, m.src_h.get()));
+  PjPtr lonlat(proj_create(m.ctx, "OGC:CRS84"));
+  if (!src_in || !lonlat) return {};
+  PjPtr to_ll(proj_create_crs_to_crs_from_pj(m.ctx, src_in.get(), lonlat.get(), nullptr, nullptr));
+  if (!to_ll) return {};
+  constexpr double kMargin = 2.0;  // degrees: "far" outside, not a building on the zone's edge
+  auto fits = [&](double a, double b) {
+    PJ_COORD ll = proj_trans(to_ll.get(), PJ_FWD, proj_coord(a, b, 0, 0));
+    const double lon = ll.xy.x, lat = ll.xy.y;
+    if (!std::isfinite(lon) || !std::isfinite(lat) || std::fabs(lat) > 90 || std::fabs(lon) > 540) return false;
+    if (lat < south - kMargin || lat > north + kMargin) return false;
+    if (west <= east) return lon >= west - kMargin && lon <= east + kMargin;
+    return lon >= west - kMargin || lon <= east + kMargin;  // across the antimeridian
+  };
+  double a = x, b = y;
+  if (m.swap_in) std::swap(a, b);
+  if (fits(a, b)) return {};
+  const bool geographic = is_geographic(m.src_type);
+  // The order the frame takes the file's numbers in: east first unless the (geographic) CRS or
+  // --axis-order says north first.
+  const bool reads_north_first = geographic ? m.north_first(m.src_h.get()) != m.swap_in : m.swap_in;
+  std::string cause;
+  if (fits(b, a)) {
+    cause = std::string("the axes look swapped (the point fits when its two numbers are exchanged): pass --axis-order ") +
+            (reads_north_first ? "east-north" : "north-east");
+  } else if (!geographic && std::fabs(x) <= 360 && std::fabs(y) <= 360) {
+    cause = "the numbers look like degrees under a projected (metre) label: name their CRS with -s_srs, e.g. "
+            "-s_srs EPSG:4326 (with --axis-order east-north if longitude comes first)";
+  } else if (geographic) {
+    cause = "the numbers do not look like degrees of that area (metres under a geographic label?): name their CRS "
+            "with -s_srs, e.g. -s_srs EPSG:25832";
+  } else {
+    cause = "the srsName does not fit the coordinates: name their CRS with -s_srs";
+  }
+  return "WARNING: the coordinates " + fmt(x) + ", " + fmt(y) + " lie far outside the area of use of " + m.source.text +
+         " (" + (area ? std::string(area).substr(0, 120) : std::string("?")) + ": longitude " + fmt(west) + " to " +
+         fmt(east) + ", latitude " + fmt(south) + " to " + fmt(north) + "); " + cause;
+}
+
 bool WorkingFrame::source_known() const { return impl_->src_known; }
 bool WorkingFrame::source_geographic() const { return is_geographic(impl_->src_type); }
 bool WorkingFrame::identity() const { return impl_->identity; }

@@ -80,6 +80,12 @@ class WorkingFrame {
   /// Transforms one point as written (for tests and anchors). Same rules as transform().
   bool transform_point(double& x, double& y) const;
 
+  /// Issue 16: when the point (x, y as written: a building's centre) lies far (> 2 degrees) outside the
+  /// source CRS's area of use (PROJ's proj_get_area_of_use), one sentence naming the point, the area, the
+  /// likely cause (axes swapped, degrees under a projected label, metres under a geographic one) and the
+  /// flag that mends it (--axis-order, -s_srs); empty when the point fits or PROJ knows no area.
+  std::string area_of_use_mismatch(double x_as_written, double y_as_written) const;
+
   bool source_known() const;            // false: no or local srsName; coordinates pass unchanged
   bool source_geographic() const;
   bool identity() const;                // nothing to do (projected metric source, no target)
