@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <unordered_map>
 
 namespace groundplan::gis {
 namespace {
@@ -290,17 +292,46 @@ std::string WorkingFrame::area_of_use_mismatch(double x, double y) const {
   const char* area = nullptr;
   if (!proj_get_area_of_use(m.ctx, m.src_h.get(), &west, &south, &east, &north, &area) || west <= -1000) return {};
   // The point as the frame reads it (transform(): swap_in, then the CRS's own order for a geographic
-  // source, easting first for a projected one) to longitude/latitude.
-  PjPtr src_in(m.src_type == PJ_TYPE_PROJECTED_CRS ? proj_normalize_for_visualization(m.ctx, m.src_h.get())
-                                                   : proj_clone(m.ctx, m.src_h.get()));
-  PjPtr lonlat(proj_create(m.ctx, "OGC:CRS84"));
-  if (!src_in || !lonlat) return {};
-  PjPtr to_ll(proj_create_crs_to_crs_from_pj(m.ctx, src_in.get(), lonlat.get(), nullptr, nullptr));
-  if (!to_ll) return {};
+  // source, easting first for a projected one) to longitude/latitude on the CRS's own datum: a datum
+  // shift is far below the margin, and the operation to OGC:CRS84 costs PROJ ~40 ms to find (per file).
+  const bool geographic = is_geographic(m.src_type);
+  const bool authority_north_first = geographic && m.north_first(m.src_h.get());
+  // Still ~10-40 ms for PROJ to make: kept per thread and source CRS, so a folder of tiles pays it once
+  // a thread, not once a file.
+  PJ* to_ll = nullptr;
+  if (!geographic) {
+    struct Cache {
+      PJ_CONTEXT* ctx = proj_context_create();
+      std::unordered_map<std::string, PjPtr> ops;
+      ~Cache() {
+        ops.clear();
+        if (ctx) proj_context_destroy(ctx);
+      }
+    };
+    thread_local Cache cache;
+    if (!cache.ctx) return {};
+    auto it = cache.ops.find(m.source.definition);
+    if (it == cache.ops.end()) {
+      if (cache.ops.size() > 64) cache.ops.clear();
+      proj_log_level(cache.ctx, PJ_LOG_NONE);
+      PjPtr src(proj_clone(cache.ctx, m.src_h.get()));
+      PjPtr src_in(src ? proj_normalize_for_visualization(cache.ctx, src.get()) : nullptr);
+      PjPtr base(src ? proj_crs_get_geodetic_crs(cache.ctx, src.get()) : nullptr);
+      PjPtr base_ll(base ? proj_normalize_for_visualization(cache.ctx, base.get()) : nullptr);
+      PjPtr op(src_in && base_ll ? proj_create_crs_to_crs_from_pj(cache.ctx, src_in.get(), base_ll.get(), nullptr, nullptr)
+                                 : nullptr);
+      it = cache.ops.emplace(m.source.definition, std::move(op)).first;
+    }
+    to_ll = it->second.get();
+    if (!to_ll) return {};
+  }
   constexpr double kMargin = 2.0;  // degrees: "far" outside, not a building on the zone's edge
   auto fits = [&](double a, double b) {
-    PJ_COORD ll = proj_trans(to_ll.get(), PJ_FWD, proj_coord(a, b, 0, 0));
-    const double lon = ll.xy.x, lat = ll.xy.y;
+    double lon = authority_north_first ? b : a, lat = authority_north_first ? a : b;
+    if (to_ll) {
+      PJ_COORD ll = proj_trans(to_ll, PJ_FWD, proj_coord(a, b, 0, 0));
+      lon = ll.xy.x, lat = ll.xy.y;
+    }
     if (!std::isfinite(lon) || !std::isfinite(lat) || std::fabs(lat) > 90 || std::fabs(lon) > 540) return false;
     if (lat < south - kMargin || lat > north + kMargin) return false;
     if (west <= east) return lon >= west - kMargin && lon <= east + kMargin;
@@ -309,7 +340,6 @@ std::string WorkingFrame::area_of_use_mismatch(double x, double y) const {
   double a = x, b = y;
   if (m.swap_in) std::swap(a, b);
   if (fits(a, b)) return {};
-  const bool geographic = is_geographic(m.src_type);
   // The order the frame takes the file's numbers in: east first unless the (geographic) CRS or
   // --axis-order says north first.
   const bool reads_north_first = geographic ? m.north_first(m.src_h.get()) != m.swap_in : m.swap_in;
