@@ -125,7 +125,9 @@ class Placer {
         const std::array<double, 4> box = extent_of(mesh);
         const std::string warning = frame->area_of_use_mismatch((box[0] + box[2]) / 2, (box[1] + box[3]) / 2);
         if (!warning.empty()) {
-          part.problems.push_back({mesh.source_id, file_, "georeference", "CRS_OUTSIDE_AREA_OF_USE", warning});
+          // Stage "read", not "georeference": a georeference- or footprint-stage problem naming a building
+          // means that building was dropped (the accounting in the problems layer); this one drops nothing.
+          part.problems.push_back({mesh.source_id, file_, "read", "CRS_OUTSIDE_AREA_OF_USE", warning});
           area_warning = true;
         }
       }

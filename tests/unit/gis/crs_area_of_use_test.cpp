@@ -68,7 +68,8 @@ TEST(CrsAreaOfUse, ProjectedLabelOverDegreesWarnsAndSaysDegenerateAfterGeorefere
   ASSERT_TRUE(w) << all(r);
   EXPECT_EQ(w->source_id, "B1");
   EXPECT_EQ(w->file, f);
-  EXPECT_EQ(w->stage, "georeference");
+  EXPECT_EQ(w->stage, "read");  // a warning: georeference/footprint-stage problems with an id are drops
+  EXPECT_EQ(r.buildings_read, r.footprints.size() + r.buildings_dropped);
   EXPECT_NE(w->reason.find("WARNING"), std::string::npos) << w->reason;
   EXPECT_NE(w->reason.find("EPSG:25832"), std::string::npos) << w->reason;
   EXPECT_NE(w->reason.find("degrees under a projected"), std::string::npos) << w->reason;
@@ -115,6 +116,11 @@ TEST(CrsAreaOfUse, GeographicLabelOverGaussKruegerMetres) {
   EXPECT_NE(w->reason.find("metres under a geographic label"), std::string::npos) << w->reason;
   EXPECT_NE(w->reason.find("-s_srs"), std::string::npos) << w->reason;
   EXPECT_EQ(r.footprints.size(), 1u);  // the good file's
+  // The bad file's building is dropped once (TRANSFORM_FAILED), not twice: one drop-stage problem names it.
+  std::size_t drops = 0;
+  for (const Problem& p : r.problems) drops += p.file == bad && p.source_id == "B1" && p.stage != "read";
+  EXPECT_EQ(drops, 1u) << all(r);
+  EXPECT_EQ(r.buildings_read, r.footprints.size() + r.buildings_dropped);
 }
 
 TEST(CrsAreaOfUse, SwappedAxesNameAxisOrder) {
