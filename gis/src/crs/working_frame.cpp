@@ -165,8 +165,18 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
 
   if (m.src_known) {
     bool authority_north_first = is_geographic(m.src_type) && m.north_first(m.src_h.get());
+    // "EPSG:4326" exactly (no URN, no URL): GDAL's GML driver reads it longitude first.
+    const std::string& t = m.source.text;
+    const bool short_epsg = t.size() > 5 && (t.compare(0, 5, "EPSG:") == 0 || t.compare(0, 5, "epsg:") == 0) &&
+                            t.find_first_not_of("0123456789", 5) == std::string::npos;
     switch (options.source_axis) {
-      case AxisOrder::Auto: m.swap_in = false; break;
+      case AxisOrder::Auto:
+        m.swap_in = authority_north_first && short_epsg && options.gml_short_epsg_east_first;
+        if (m.swap_in)
+          m.notes.push_back("srsName \"" + t + "\" in its short form: read longitude first, as GDAL's GML driver does "
+                            "(the URN/URL forms keep EPSG's latitude first); --axis-order north-east if the file "
+                            "writes latitude first");
+        break;
       case AxisOrder::EastNorth: m.swap_in = authority_north_first; break;
       case AxisOrder::NorthEast: m.swap_in = !authority_north_first && is_geographic(m.src_type); break;
     }

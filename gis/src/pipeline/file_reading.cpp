@@ -92,6 +92,9 @@ class Placer {
         // --axis-order wins; else the order the format fixes (OGR: GDAL's data axis order), else the CRS's rule.
         const AxisOrder format_axis = read_info_ ? read_info_->source_axis : AxisOrder::Auto;
         crs.source_axis = options_.source_axis != AxisOrder::Auto ? options_.source_axis : format_axis;
+        // A CityGML srsName (not -s_srs) in the short form "EPSG:n": GDAL's GML convention, longitude first.
+        crs.gml_short_epsg_east_first =
+            options_.s_srs.empty() && (!read_info_ || read_info_->format == InputFormat::CityGml);
         // -s_srs / -a_srs win; else the CRS the format gives (OGR: the layer's), else the srsName read so far.
         frame_srs = !options_.s_srs.empty()                             ? options_.s_srs
                     : read_info_ && !read_info_->source_srs.empty() ? read_info_->source_srs

@@ -136,10 +136,26 @@ TEST(CrsAreaOfUse, SwappedAxesNameAxisOrder) {
   EXPECT_EQ(ok.footprints.size(), 1u);
 }
 
+// GDAL's GML convention: srsName "EPSG:4326" (short form) is longitude first; the URN form keeps EPSG's
+// latitude first. The same house written each way lands in the same place.
+TEST(CrsAreaOfUse, GmlShortEpsgIsLongitudeFirst) {
+  const test::TempDir dir("groundplan_crs_area_test");
+  const PipelineResult s = run({dir.file("short.gml", citygml("EPSG:4326", 8.4, 49.0, 0.00014, 0.00008))});
+  const PipelineResult u = run({dir.file("urn.gml", citygml("urn:ogc:def:crs:EPSG::4326", 8.4, 49.0, 0.00014, 0.00008, true))});
+  ASSERT_EQ(s.plans.size(), 1u);
+  EXPECT_EQ(s.crs_name, "EPSG:32632");
+  EXPECT_EQ(u.crs_name, "EPSG:32632");
+  EXPECT_EQ(test::plan_keys(s.plans), test::plan_keys(u.plans));
+  bool noted = false;
+  for (const Problem& p : s.problems) noted |= p.code == "NOTE" && p.reason.find("short form") != std::string::npos;
+  EXPECT_TRUE(noted) << all(s);
+}
+
 TEST(CrsAreaOfUse, FittingFilesAndRealSamplesSayNothing) {
   const test::TempDir dir("groundplan_crs_area_test");
   for (const std::string& f : {dir.file("utm.gml", citygml("EPSG:25832", 456000, 5428000, 10, 9)),
-                               dir.file("ll.gml", citygml("EPSG:4326", 49.0, 8.4, 0.00008, 0.00014)),
+                               dir.file("ll.gml", citygml("EPSG:4326", 8.4, 49.0, 0.00014, 0.00008)),
+                               dir.file("urn.gml", citygml("urn:ogc:def:crs:EPSG::4326", 8.4, 49.0, 0.00014, 0.00008, true)),
                                test::shared_data("cityjson-3dbag-cjseq/3dbag_b2.city.json"),
                                test::shared_data("citygml-ogc-spec-samples/v2_Building_LOD2-EPSG25832.gml")}) {
     const PipelineResult r = run({f});

@@ -44,6 +44,10 @@ enum class AxisOrder {
 struct CrsOptions {
   std::string target_srs;            // -t_srs: any form parse_srs_name understands; empty = automatic
   AxisOrder source_axis = AxisOrder::Auto;
+  /// GDAL's GML convention (its GML driver, GML_CONSIDER_EPSG_AS_URN=NO): an srsName written in the short
+  /// form "EPSG:n" is read longitude/easting first even where the EPSG axis order is latitude first; the
+  /// URN and URL forms keep the authority order. Applies with source_axis Auto only; set for CityGML.
+  bool gml_short_epsg_east_first = false;
 };
 
 /// The working CRS, for the OGR layer.
