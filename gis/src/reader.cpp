@@ -6,6 +6,7 @@
 #include <groundplan/gis/placement.h>
 #include <groundplan/gis/reader.h>
 
+#include <cpl_conv.h>
 #include <cpl_vsi.h>
 
 #include "cityjson/read_into.h"
@@ -51,9 +52,14 @@ InputFormat sniff(std::string_view head) {
   return InputFormat::Unknown;
 }
 
+/// `name` less a trailing ".gz" when it names a gzip input; else `name`.
+std::string without_gz(const std::string& name) {
+  return is_gzip_input_name(name) ? name.substr(0, name.size() - 3) : name;
+}
+
 std::string read_head(const std::string& path) {
   std::string head(4096, '\0');
-  VSILFILE* f = VSIFOpenL(path.c_str(), "rb");
+  VSILFILE* f = VSIFOpenL(open_path(path).c_str(), "rb");
   if (!f) return {};
   head.resize(VSIFReadL(head.data(), 1, head.size(), f));
   VSIFCloseL(f);
@@ -78,7 +84,22 @@ const char* to_string(InputFormat f) {
   return "?";
 }
 
-InputFormat detect_format(const std::string& name, std::string_view head) {
+bool is_gzip_input_name(const std::string& name) {
+  const std::string l = lower(name);
+  if (!ends_with(l, ".gz")) return false;
+  const std::string inner = l.substr(0, l.size() - 3);
+  const std::string ext = extension(inner);
+  return ext == ".gml" || ext == ".citygml" || ext == ".xml" || ext == ".kml" || ends_with(inner, ".city.json") ||
+         ends_with(inner, ".city.jsonl");
+}
+
+std::string open_path(const std::string& path) {
+  if (!is_gzip_input_name(path) || path.rfind("/vsi", 0) == 0) return path;
+  return "/vsigzip/" + path;
+}
+
+InputFormat detect_format(const std::string& gz_name, std::string_view head) {
+  const std::string name = without_gz(gz_name);
   const std::string ext = extension(name);
   if (ext == ".gml" || ext == ".citygml") return InputFormat::CityGml;
   if (ext == ".kml") return InputFormat::Kml;
@@ -96,7 +117,7 @@ InputFormat detect_format(const std::string& name, std::string_view head) {
 }
 
 InputFormat detect_format(const std::string& path) {
-  const std::string ext = extension(path);
+  const std::string ext = extension(without_gz(path));
   if (!ext.empty() && ext != ".xml" && ext != ".json") {
     const InputFormat f = detect_format(path, std::string_view());
     if (f != InputFormat::Unknown) return f;
@@ -105,6 +126,7 @@ InputFormat detect_format(const std::string& path) {
 }
 
 bool is_input_name(const std::string& name) {
+  if (is_gzip_input_name(name)) return true;
   const std::string ext = extension(name);
   return ext == ".gml" || ext == ".citygml" || ext == ".xml" || ext == ".kml" || ext == ".kmz" || ext == ".gltf" ||
          ext == ".glb" || ends_with(lower(name), ".city.json") || ends_with(lower(name), ".city.jsonl");
@@ -124,11 +146,50 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
                             "COLLADA .dae, CityJSON .city.json/.json, CityJSONSeq .city.jsonl, and any vector format GDAL "
                             "reads: none of them knows it)");
   }
+  // A gzip input is read through /vsigzip/, and no further than gzip_max_ratio times its packed size.
+  const std::string open = open_path(path);
+  std::uint64_t max_bytes = 0;  // 0: no limit
+  if (open.rfind("/vsigzip/", 0) == 0) {
+    VSIStatBufL st;
+    const std::uint64_t packed = VSIStatL(open.c_str() + 9, &st) == 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+    const std::uint64_t ratio = std::max<std::uint64_t>(1, options.gzip_max_ratio);
+    max_bytes = std::max(options.gzip_min_bytes, packed > UINT64_MAX / ratio ? UINT64_MAX : packed * ratio);
+  }
+  // GDAL caches a .gz's unpacked size in x.gz.properties beside it: an input is not ours to write beside.
+  struct NoGzipProperties {
+    std::string old;
+    bool had = false;
+    explicit NoGzipProperties(bool on) {
+      if (!on) return;
+      const char* v = CPLGetThreadLocalConfigOption("CPL_VSIL_GZIP_WRITE_PROPERTIES", nullptr);
+      had = v != nullptr;
+      if (v) old = v;
+      CPLSetThreadLocalConfigOption("CPL_VSIL_GZIP_WRITE_PROPERTIES", "NO");
+      set = true;
+    }
+    ~NoGzipProperties() {
+      if (set) CPLSetThreadLocalConfigOption("CPL_VSIL_GZIP_WRITE_PROPERTIES", had ? old.c_str() : nullptr);
+    }
+    bool set = false;
+  } no_properties(max_bytes != 0);
+  auto too_big = [&](std::uint64_t read) {
+    return InputError(path + ": unpacks to more than " + std::to_string(max_bytes) + " bytes after " +
+                      std::to_string(read) + " read, over " + std::to_string(options.gzip_max_ratio) +
+                      " times its compressed size; stopped (gzip bomb?). If the file is genuine, gunzip it and read "
+                      "the plain file");
+  };
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
     opt.lod = options.lod;
     opt.on_bytes = options.on_bytes;
-    read_citygml(path, opt, [&](Mesh&& m) {
+    std::uint64_t unpacked = 0;
+    if (max_bytes)
+      opt.on_bytes = [&](std::uint64_t n) {
+        unpacked += n;
+        if (unpacked > max_bytes) throw too_big(unpacked);
+        if (options.on_bytes) options.on_bytes(n);
+      };
+    read_citygml(open, opt, [&](Mesh&& m) {
       ++info.meshes;
       if (info.source_srs != info.citygml.srs_name) info.source_srs = info.citygml.srs_name;
       on_mesh(std::move(m));
@@ -136,7 +197,7 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     return;
   }
   if (info.format == InputFormat::CityJson || info.format == InputFormat::CityJsonSeq) {
-    cityjson::read_into(path, options, on_mesh, problems, info);
+    cityjson::read_into(open, options, max_bytes, on_mesh, problems, info);
     return;
   }
   if (info.format == InputFormat::Ogr) {
@@ -175,7 +236,7 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     case InputFormat::Kml:
     case InputFormat::Kmz:
       try {
-        read_kml(path, options.kml, [&](Mesh&& mesh, const ModelPlacement& pl) {
+        read_kml(open, options.kml, [&](Mesh&& mesh, const ModelPlacement& pl) {
           std::string reason;
           const bool ok = geo.place_local(mesh, pl, &reason);
           deliver(mesh, ok, reason);

@@ -3,6 +3,7 @@
 // reader does (citygml_chunks.h says why a cut is safe).
 #include <groundplan/error.h>
 #include <groundplan/gis/citygml_chunks.h>
+#include <groundplan/gis/reader.h>
 
 #include "citygml/file_problems.h"
 
@@ -115,7 +116,7 @@ std::uint64_t next_member_start(VsiFile& file, std::uint64_t from, std::uint64_t
 CityGmlChunkPlan plan_citygml_chunks(const std::string& path, std::uint64_t chunk_bytes,
                                      std::uint64_t first_chunk_bytes) {
   CityGmlChunkPlan plan;
-  if (path.rfind("/vsi", 0) == 0 && path.rfind("/vsimem/", 0) != 0) {
+  if ((path.rfind("/vsi", 0) == 0 && path.rfind("/vsimem/", 0) != 0) || is_gzip_input_name(path)) {
     plan.why_not = "compressed or virtual input (read as one stream)";
     return plan;
   }

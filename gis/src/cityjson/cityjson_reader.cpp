@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
 // CityJSON and CityJSONSeq front ends (issue 16). Why simdjson: reading must beat GML by a wide margin
-// (>= 200 MB/s per core); simdjson's On-Demand walks the file without building a DOM, so the file's
-// bytes and its structural index are all it holds. CityJSON puts "vertices" anywhere among the
-// top-level keys (usually after "CityObjects"), so the file is walked twice: the first pass takes
-// transform, metadata, templates and vertices, the second hands each city object's text to a small
-// DOM parser (bounded by that object), so one malformed object is a Problem, not the file's end.
+// (>= 200 MB/s per core). A valid CityJSON file is parsed once into simdjson's DOM (the library's
+// runtime-dispatched AVX2/AVX-512 kernel: Debian's simdjson 3.0.1 gives On-Demand only the portable one
+// without -march), with the parser and the file's buffer kept per thread between files (first-touch page
+// faults of a fresh parser cost more than the parse). CityJSON puts "vertices" anywhere among the
+// top-level keys (3DBAG: after "CityObjects"), so the whole document is needed before any object.
+// Where the DOM parse fails (a broken object), the file is read again object by object: an On-Demand
+// pass takes transform, metadata, templates and vertices, a second hands each city object's text to a
+// small DOM parser, so one malformed object is a Problem naming it, not the file's end.
 // CityJSONSeq (one JSON document per line) is read line by line through a bounded buffer.
 #include <groundplan/error.h>
 #include <groundplan/gis/cityjson.h>
@@ -14,8 +17,13 @@
 #include <cpl_vsi.h>
 #include <simdjson.h>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 
@@ -111,108 +119,292 @@ bool looks_like_cityjson(std::string_view head, bool* sequence) {
   return found;
 }
 
+namespace {
+
+/// Asks Linux for transparent huge pages on a large buffer about to be written: one fault per 2 MiB
+/// instead of per 4 KiB. On the VMs we measured, first-touch faults of the parser's buffers cost more
+/// than the parse itself (tests/bench/RESULTS.md). A hint only; nothing changes where it is refused.
+void prefer_huge_pages(const void* p, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kPage = 4096;
+  if (bytes < (std::size_t{4} << 20)) return;
+  const auto begin = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
+  const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
+  if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+InputError too_many_bytes(const std::string& path, std::uint64_t max_bytes) {
+  return InputError(path + ": unpacks to more than " + std::to_string(max_bytes) +
+                    " bytes, the limit for a compressed input (ReadOptions::gzip_max_ratio times its packed size); "
+                    "stopped (gzip bomb?). If the file is genuine, unpack it and read the plain file");
+}
+
+/// Per reading thread: the file's bytes and a DOM parser, kept from one file to the next, so that their
+/// pages are allocated and first touched once per thread rather than once per file (on the machines we
+/// measured, page faults cost more than the parse: tests/bench/RESULTS.md). Both are released after a
+/// file larger than kKeepBytes, so that a thread does not hold gigabytes between files.
+struct Scratch {
+  std::unique_ptr<char[]> bytes;
+  std::size_t capacity = 0;
+  dom::parser whole;
+  std::vector<Point3> vertices;
+  bool in_use = false;
+};
+constexpr std::size_t kKeepBytes = std::size_t{64} << 20;
+
+/// The thread's Scratch, or a fresh one when the thread is already inside read_cityjson (a callback that
+/// waits in TBB may run another file's task on this thread).
+class ScratchLease {
+ public:
+  ScratchLease() {
+    thread_local Scratch mine;
+    if (mine.in_use) {
+      local_ = std::make_unique<Scratch>();
+      s_ = local_.get();
+    } else {
+      s_ = &mine;
+    }
+    s_->in_use = true;
+  }
+  ~ScratchLease() {
+    s_->in_use = false;
+    if (s_->capacity > kKeepBytes) {
+      s_->bytes.reset();
+      s_->capacity = 0;
+      s_->whole = dom::parser{};
+      std::vector<Point3>().swap(s_->vertices);
+    }
+  }
+  Scratch& operator*() { return *s_; }
+  Scratch* operator->() { return s_; }
+
+ private:
+  std::unique_ptr<Scratch> local_;
+  Scratch* s_ = nullptr;
+};
+
+/// The whole file into s.bytes, padded as simdjson needs (GDAL VSI: plain files, /vsigzip/, /vsizip/,
+/// /vsimem/). One allocation of the stated size (+ padding) when the size is known. Returns the length.
+std::size_t load(const std::string& path, std::uint64_t max_bytes, Scratch& s) {
+  VsiFile holder;
+  VSILFILE* f = open_or_throw(path, holder);
+  VSIStatBufL st;
+  std::size_t stated = 0;
+  // Not for /vsigzip/: its size is known only by unpacking it all, and a gzip bomb states what it likes.
+  if (path.rfind("/vsigzip/", 0) != 0 && VSIStatL(path.c_str(), &st) == 0 && st.st_size > 0 && static_cast<std::uint64_t>(st.st_size) <= simdjson::SIMDJSON_MAXSIZE_BYTES)
+    stated = static_cast<std::size_t>(st.st_size);
+  std::size_t length = 0;
+  auto grow = [&](std::size_t want) {
+    std::unique_ptr<char[]> next(new char[want]);
+    prefer_huge_pages(next.get(), want);
+    if (length) std::memcpy(next.get(), s.bytes.get(), length);
+    s.bytes = std::move(next);
+    s.capacity = want;
+  };
+  // + 1: the read after the last byte finds the end without growing
+  if (s.capacity < stated + simdjson::SIMDJSON_PADDING + 1) grow(stated + simdjson::SIMDJSON_PADDING + 1);
+  for (;;) {
+    if (length > simdjson::SIMDJSON_MAXSIZE_BYTES)
+      throw InputError(path + ": larger than 4 GiB, the most a CityJSON file can be read as one document; convert it "
+                              "to CityJSONSeq (cjseq cat, or cjio export jsonl) and read the .city.jsonl");
+    if (s.capacity - length <= simdjson::SIMDJSON_PADDING) grow(std::max<std::size_t>(2 * s.capacity, 1 << 20));
+    const std::size_t got = VSIFReadL(s.bytes.get() + length, 1, s.capacity - length - simdjson::SIMDJSON_PADDING, f);
+    length += got;
+    if (max_bytes && length > max_bytes) throw too_many_bytes(path, max_bytes);
+    if (got == 0) break;
+  }
+  std::memset(s.bytes.get() + length, 0, simdjson::SIMDJSON_PADDING);
+  return length;
+}
+
+/// What the top-level walk gathers before the city objects are converted.
+struct TopLevel {
+  Transform transform;
+  Templates templates;
+  std::vector<double> raw;  // vertices as written until "transform" is known (it may come after them)
+  bool is_cityjson = false;
+  bool has_objects = false;
+};
+
+/// One vertex as written: three numbers, else NaN (counted as bad later).
+template <class Array>
+void push_raw_vertex(Array coords, bool is_array, std::vector<double>& raw) {
+  double xyz[3] = {NAN, NAN, NAN};
+  std::size_t n = 0;
+  bool ok = is_array;
+  if (is_array) {
+    for (auto c : coords) {
+      double d = NAN;
+      if (n < 3 && c.get_double().get(d) == simdjson::SUCCESS) xyz[n] = d;
+      else ok = false;
+      ++n;
+    }
+  }
+  ok = ok && n == 3;
+  raw.insert(raw.end(), {ok ? xyz[0] : NAN, xyz[1], xyz[2]});
+}
+
+void check_type(std::string_view type, const std::string& path) {
+  if (type != "CityJSON")
+    throw InputError(path + ": \"type\" is \"" + std::string(type.substr(0, 40)) +
+                     "\", not \"CityJSON\" (a CityJSONFeature line belongs in a .city.jsonl sequence)");
+}
+
+/// Vertices with the transform applied; the top-level checks.
+std::vector<Point3> finish_top(TopLevel& top, const std::string& path, std::vector<Problem>& problems, CityJsonInfo& info) {
+  if (!top.is_cityjson) throw InputError(path + ": no \"type\": \"CityJSON\" at the top level; not a CityJSON file");
+  if (!top.has_objects) throw InputError(path + ": no \"CityObjects\"; not a CityJSON file");
+  std::vector<Point3> vertices;
+  std::size_t bad_vertices = 0;
+  vertices.reserve(top.raw.size() / 3);
+  for (std::size_t i = 0; i + 2 < top.raw.size(); i += 3)
+    cityjson::add_vertex(vertices, &top.raw[i],
+                         std::isfinite(top.raw[i]) && std::isfinite(top.raw[i + 1]) && std::isfinite(top.raw[i + 2]),
+                         top.transform, bad_vertices);
+  std::vector<double>().swap(top.raw);
+  info.vertices = vertices.size();
+  note_bad_vertices(bad_vertices, "\"vertices\"", path, problems);
+  return vertices;
+}
+
+/// The fast path: the whole file as one DOM, parsed by simdjson's runtime-dispatched kernel (icelake,
+/// haswell ...; Debian's simdjson gives On-Demand only the portable one), each city object converted
+/// from it with no second parse. Returns false, having read nothing, when the file is not valid JSON
+/// (or nests deeper than max_depth): the object-by-object path then says which object is broken.
+bool read_whole_dom(Scratch& scratch, std::size_t length, const std::string& path, const CityJsonOptions& options,
+                    std::vector<Problem>& problems, CityJsonInfo& info, ObjectConverter& converter) {
+  dom::parser& parser = scratch.whole;
+  if (parser.capacity() < length || parser.max_depth() != options.max_depth) {
+    const std::size_t capacity = std::max(length, parser.capacity());
+    if (parser.allocate(capacity, options.max_depth) != simdjson::SUCCESS) return false;
+    // Lower bounds of what allocate() took (simdjson 3.0.1: tape 8, strings 5/3, index 4 bytes a byte).
+    prefer_huge_pages(parser.doc.tape.get(), 8 * capacity);
+    prefer_huge_pages(parser.doc.string_buf.get(), capacity / 3 * 5);
+    if (parser.implementation) prefer_huge_pages(parser.implementation->structural_indexes.get(), 4 * capacity);
+  }
+  dom::element root_el;
+  if (parser.parse(scratch.bytes.get(), length, false).get(root_el) != simdjson::SUCCESS) return false;
+  dom::object root;
+  if (root_el.get_object().get(root) != simdjson::SUCCESS) return false;
+  TopLevel top;
+  std::vector<dom::array> vertex_arrays;  // "vertices" (once, in a valid file), read when "transform" is known
+  std::uint64_t at_object = 0;
+  try {
+    for (dom::key_value_pair field : root) {
+      const std::string_view key = field.key;
+      if (key == "type") {
+        check_type(field.value.get_string(), path);
+        top.is_cityjson = true;
+      } else if (key == "version") {
+        info.version = std::string(std::string_view(field.value.get_string()).substr(0, 16));
+      } else if (key == "transform") {
+        field.value.get_object().value();  // as the On-Demand path: not an object is not CityJSON
+        top.transform = cityjson::parse_transform(field.value, path);
+      } else if (key == "metadata") {
+        field.value.get_object().value();
+        read_metadata(field.value, info);
+      } else if (key == "geometry-templates") {
+        field.value.get_object().value();
+        top.templates = cityjson::parse_templates(field.value, path, problems);
+      } else if (key == "vertices") {
+        vertex_arrays.push_back(field.value.get_array());
+      } else if (key == "CityObjects") {
+        top.has_objects = true;
+      }
+    }
+    finish_top(top, path, problems, info);  // the checks; no raw vertices on this path
+    // Straight into the thread's vector (its pages stay mapped from one file to the next).
+    std::vector<Point3>& vertices = scratch.vertices;
+    vertices.clear();
+    std::size_t n = 0, bad = 0;
+    for (dom::array a : vertex_arrays) n += a.size();
+    if (vertices.capacity() < n) {
+      vertices.reserve(n);
+      prefer_huge_pages(vertices.data(), n * sizeof(Point3));
+    }
+    for (dom::array a : vertex_arrays)
+      for (dom::element v : a) {
+        double xyz[3] = {NAN, NAN, NAN};
+        dom::array coords;
+        bool ok = v.get_array().get(coords) == simdjson::SUCCESS;
+        std::size_t k = 0;
+        if (ok)
+          for (dom::element c : coords) {
+            if (k >= 3 || c.get_double().get(xyz[k]) != simdjson::SUCCESS) ok = false;
+            ++k;
+          }
+        cityjson::add_vertex(vertices, xyz, ok && k == 3, top.transform, bad);
+      }
+    info.vertices = vertices.size();
+    note_bad_vertices(bad, "\"vertices\"", path, problems);
+    for (dom::key_value_pair field : root) {
+      if (field.key != "CityObjects") continue;
+      for (dom::key_value_pair object : field.value.get_object()) {
+        ++at_object;
+        object.value.get_object().value();  // as the On-Demand path: a city object that is no object ends the file
+        converter.convert(object.key, object.value, vertices, top.templates);
+      }
+    }
+  } catch (const simdjson::simdjson_error& e) {
+    std::string where = at_object ? " (at city object " + std::to_string(at_object) + ")" : "";
+    throw InputError(path + ": not valid CityJSON" + where + ": " + e.what());
+  }
+  return true;
+}
+
+}  // namespace
+
 void read_cityjson(const std::string& path, const CityJsonOptions& options, const MeshCallback& on_mesh,
                    std::vector<Problem>& problems, CityJsonInfo& info) {
   info = CityJsonInfo{};
-  // The whole file, padded as simdjson needs (GDAL VSI: plain files, /vsigzip/, /vsizip/, /vsimem/).
-  // One allocation of the stated size (+ padding) when the size is known: on this kind of machine
-  // page faults and copies of a growing buffer cost more than the parse (tests/bench/RESULTS.md).
-  std::unique_ptr<char[]> bytes;
-  std::size_t capacity = 0, length = 0;
-  {
-    VsiFile holder;
-    VSILFILE* f = open_or_throw(path, holder);
-    VSIStatBufL st;
-    std::size_t stated = 0;
-    if (VSIStatL(path.c_str(), &st) == 0 && st.st_size > 0 && static_cast<std::uint64_t>(st.st_size) <= simdjson::SIMDJSON_MAXSIZE_BYTES)
-      stated = static_cast<std::size_t>(st.st_size);
-    auto grow = [&](std::size_t want) {
-      std::unique_ptr<char[]> next(new char[want]);
-      if (length) std::memcpy(next.get(), bytes.get(), length);
-      bytes = std::move(next);
-      capacity = want;
-    };
-    grow(stated + simdjson::SIMDJSON_PADDING + 1);  // + 1: the read after the last byte finds the end without growing
-    for (;;) {
-      if (length > simdjson::SIMDJSON_MAXSIZE_BYTES)
-        throw InputError(path + ": larger than 4 GiB, the most a CityJSON file can be read as one document; convert it "
-                                "to CityJSONSeq (cjseq cat, or cjio export jsonl) and read the .city.jsonl");
-      if (capacity - length <= simdjson::SIMDJSON_PADDING) grow(std::max<std::size_t>(2 * capacity, 1 << 20));
-      const std::size_t got = VSIFReadL(bytes.get() + length, 1, capacity - length - simdjson::SIMDJSON_PADDING, f);
-      length += got;
-      if (got == 0) break;
-    }
-  }
+  ScratchLease scratch;
+  const std::size_t length = load(path, options.max_bytes, *scratch);
   info.bytes = length;
-  std::memset(bytes.get() + length, 0, simdjson::SIMDJSON_PADDING);
-  const simdjson::padded_string_view json(bytes.get(), length, capacity);
+  const simdjson::padded_string_view json(scratch->bytes.get(), length, scratch->capacity);
+  ObjectConverter converter(path, options, on_mesh, problems, info);
+  if (read_whole_dom(*scratch, length, path, options, problems, info, converter)) return;
 
-  Transform transform;
+  // Not valid JSON somewhere: On-Demand over the top level, each city object parsed on its own, so that
+  // one broken object is a Problem naming it and the others are read.
   std::unique_ptr<dom::parser> meta_parser = make_dom_parser(options.max_depth);
   std::unique_ptr<dom::parser> template_parser = make_dom_parser(options.max_depth);
-  Templates templates;
-  std::vector<Point3> vertices;
-  std::vector<double> raw;  // vertices as written until "transform" is known (it may come after them)
-  std::size_t bad_vertices = 0;
-  ObjectConverter converter(path, options, on_mesh, problems, info);
+  TopLevel top;
   std::uint64_t at_object = 0;  // for messages: the city object being read
   try {
     ondemand::parser parser;
     ondemand::document doc = parser.iterate(json);
     ondemand::object root = doc.get_object();
-    bool is_cityjson = false;
-    bool has_objects = false;
     for (auto field : root) {
       const std::string_view key = field.unescaped_key();
       if (key == "type") {
-        const std::string_view type = field.value().get_string();
-        if (type != "CityJSON")
-          throw InputError(path + ": \"type\" is \"" + std::string(type.substr(0, 40)) +
-                           "\", not \"CityJSON\" (a CityJSONFeature line belongs in a .city.jsonl sequence)");
-        is_cityjson = true;
+        check_type(field.value().get_string(), path);
+        top.is_cityjson = true;
       } else if (key == "version") {
         info.version = std::string(std::string_view(field.value().get_string()).substr(0, 16));
       } else if (key == "transform") {
         const std::string_view text = object_text(field.value());
-        transform = cityjson::parse_transform(meta_parser->parse(text.data(), text.size(), false), path);
+        top.transform = cityjson::parse_transform(meta_parser->parse(text.data(), text.size(), false), path);
       } else if (key == "metadata") {
         const std::string_view text = object_text(field.value());
         read_metadata(meta_parser->parse(text.data(), text.size(), false), info);
       } else if (key == "geometry-templates") {
         const std::string_view text = object_text(field.value());
-        templates = cityjson::parse_templates(template_parser->parse(text.data(), text.size(), false), path, problems);
+        top.templates = cityjson::parse_templates(template_parser->parse(text.data(), text.size(), false), path, problems);
       } else if (key == "vertices") {
         for (auto v : field.value().get_array()) {
-          double xyz[3] = {NAN, NAN, NAN};
-          std::size_t n = 0;
-          bool ok = true;
           ondemand::array coords;
-          if (v.get_array().get(coords) != simdjson::SUCCESS) {
-            ok = false;
-          } else {
-            for (auto c : coords) {
-              double d = NAN;
-              if (n < 3 && c.get_double().get(d) == simdjson::SUCCESS) xyz[n] = d;
-              else ok = false;
-              ++n;
-            }
-          }
-          ok = ok && n == 3;
-          raw.insert(raw.end(), {ok ? xyz[0] : NAN, xyz[1], xyz[2]});
+          const bool is_array = v.get_array().get(coords) == simdjson::SUCCESS;
+          push_raw_vertex(coords, is_array, top.raw);
         }
       } else if (key == "CityObjects") {
-        has_objects = true;  // second pass
+        top.has_objects = true;  // second pass
       }
     }
-    if (!is_cityjson) throw InputError(path + ": no \"type\": \"CityJSON\" at the top level; not a CityJSON file");
-    if (!has_objects) throw InputError(path + ": no \"CityObjects\"; not a CityJSON file");
-    vertices.reserve(raw.size() / 3);
-    for (std::size_t i = 0; i + 2 < raw.size(); i += 3)
-      cityjson::add_vertex(vertices, &raw[i], std::isfinite(raw[i]) && std::isfinite(raw[i + 1]) && std::isfinite(raw[i + 2]),
-                           transform, bad_vertices);
-    std::vector<double>().swap(raw);
-    info.vertices = vertices.size();
-    note_bad_vertices(bad_vertices, "\"vertices\"", path, problems);
+    const std::vector<Point3> vertices = finish_top(top, path, problems, info);
 
     // A second iteration rather than doc.rewind(): UBSan finds rewind() reading a null parser after some
     // malformed first passes (simdjson 3.0.1); the same parser keeps its buffers, only stage 1 runs again.
@@ -231,7 +423,7 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
                                      std::string("city object is not valid JSON: ") + simdjson::error_message(err)});
           continue;
         }
-        converter.convert(id, element, vertices, templates);
+        converter.convert(id, element, vertices, top.templates);
       }
     }
   } catch (const simdjson::simdjson_error& e) {
@@ -338,6 +530,7 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
     const std::size_t got = VSIFReadL(buf.data() + at, 1, kChunk, f);
     buf.resize(at + got);
     info.bytes += got;
+    if (options.max_bytes && info.bytes > options.max_bytes) throw too_many_bytes(path, options.max_bytes);
     eof = got < kChunk;
     std::size_t scan = at;
     for (;;) {

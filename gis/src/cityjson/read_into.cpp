@@ -3,11 +3,12 @@
 
 namespace groundplan::gis::cityjson {
 
-void read_into(const std::string& path, const ReadOptions& options, const MeshCallback& on_mesh,
+void read_into(const std::string& path, const ReadOptions& options, std::uint64_t max_bytes, const MeshCallback& on_mesh,
                std::vector<Problem>& problems, ReadInfo& info) {
   CityJsonOptions opt = options.cityjson;
   opt.lod = options.lod;
   opt.lod_refinement = options.lod_refinement;
+  if (max_bytes) opt.max_bytes = max_bytes;
   // The CRS as the pipeline reads it for CityGML: set before the first mesh (the pipeline makes the
   // working frame then; CityJSON's metadata is read before any object), and again at the end.
   struct Publish {

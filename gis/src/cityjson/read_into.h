@@ -7,7 +7,7 @@ namespace groundplan::gis::cityjson {
 
 /// Reads info.format (CityJson or CityJsonSeq) and fills info.cityjson, and info.citygml's srs_name and
 /// envelope, so that the pipeline builds the working frame of a CityJSON file as it does for CityGML.
-void read_into(const std::string& path, const ReadOptions& options, const MeshCallback& on_mesh,
+void read_into(const std::string& path, const ReadOptions& options, std::uint64_t max_bytes, const MeshCallback& on_mesh,
                std::vector<Problem>& problems, ReadInfo& info);
 
 }  // namespace groundplan::gis::cityjson

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <unordered_map>
 
 namespace groundplan::gis {
 namespace {
@@ -163,8 +165,18 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
 
   if (m.src_known) {
     bool authority_north_first = is_geographic(m.src_type) && m.north_first(m.src_h.get());
+    // "EPSG:4326" exactly (no URN, no URL): GDAL's GML driver reads it longitude first.
+    const std::string& t = m.source.text;
+    const bool short_epsg = t.size() > 5 && (t.compare(0, 5, "EPSG:") == 0 || t.compare(0, 5, "epsg:") == 0) &&
+                            t.find_first_not_of("0123456789", 5) == std::string::npos;
     switch (options.source_axis) {
-      case AxisOrder::Auto: m.swap_in = false; break;
+      case AxisOrder::Auto:
+        m.swap_in = authority_north_first && short_epsg && options.gml_short_epsg_east_first;
+        if (m.swap_in)
+          m.notes.push_back("srsName \"" + t + "\" in its short form: read longitude first, as GDAL's GML driver does "
+                            "(the URN/URL forms keep EPSG's latitude first); --axis-order north-east if the file "
+                            "writes latitude first");
+        break;
       case AxisOrder::EastNorth: m.swap_in = authority_north_first; break;
       case AxisOrder::NorthEast: m.swap_in = !authority_north_first && is_geographic(m.src_type); break;
     }
@@ -281,6 +293,82 @@ bool WorkingFrame::transform(Mesh& mesh, std::string* reason) {
     }
   }
   return true;
+}
+
+std::string WorkingFrame::area_of_use_mismatch(double x, double y) const {
+  const Impl& m = *impl_;
+  if (!m.src_known || !m.src_h || !std::isfinite(x) || !std::isfinite(y)) return {};
+  double west = 0, south = 0, east = 0, north = 0;
+  const char* area = nullptr;
+  if (!proj_get_area_of_use(m.ctx, m.src_h.get(), &west, &south, &east, &north, &area) || west <= -1000) return {};
+  // The point as the frame reads it (transform(): swap_in, then the CRS's own order for a geographic
+  // source, easting first for a projected one) to longitude/latitude on the CRS's own datum: a datum
+  // shift is far below the margin, and the operation to OGC:CRS84 costs PROJ ~40 ms to find (per file).
+  const bool geographic = is_geographic(m.src_type);
+  const bool authority_north_first = geographic && m.north_first(m.src_h.get());
+  // Still ~10-40 ms for PROJ to make: kept per thread and source CRS, so a folder of tiles pays it once
+  // a thread, not once a file.
+  PJ* to_ll = nullptr;
+  if (!geographic) {
+    struct Cache {
+      PJ_CONTEXT* ctx = proj_context_create();
+      std::unordered_map<std::string, PjPtr> ops;
+      ~Cache() {
+        ops.clear();
+        if (ctx) proj_context_destroy(ctx);
+      }
+    };
+    thread_local Cache cache;
+    if (!cache.ctx) return {};
+    auto it = cache.ops.find(m.source.definition);
+    if (it == cache.ops.end()) {
+      if (cache.ops.size() > 64) cache.ops.clear();
+      proj_log_level(cache.ctx, PJ_LOG_NONE);
+      PjPtr src(proj_clone(cache.ctx, m.src_h.get()));
+      PjPtr src_in(src ? proj_normalize_for_visualization(cache.ctx, src.get()) : nullptr);
+      PjPtr base(src ? proj_crs_get_geodetic_crs(cache.ctx, src.get()) : nullptr);
+      PjPtr base_ll(base ? proj_normalize_for_visualization(cache.ctx, base.get()) : nullptr);
+      PjPtr op(src_in && base_ll ? proj_create_crs_to_crs_from_pj(cache.ctx, src_in.get(), base_ll.get(), nullptr, nullptr)
+                                 : nullptr);
+      it = cache.ops.emplace(m.source.definition, std::move(op)).first;
+    }
+    to_ll = it->second.get();
+    if (!to_ll) return {};
+  }
+  constexpr double kMargin = 2.0;  // degrees: "far" outside, not a building on the zone's edge
+  auto fits = [&](double a, double b) {
+    double lon = authority_north_first ? b : a, lat = authority_north_first ? a : b;
+    if (to_ll) {
+      PJ_COORD ll = proj_trans(to_ll, PJ_FWD, proj_coord(a, b, 0, 0));
+      lon = ll.xy.x, lat = ll.xy.y;
+    }
+    if (!std::isfinite(lon) || !std::isfinite(lat) || std::fabs(lat) > 90 || std::fabs(lon) > 540) return false;
+    if (lat < south - kMargin || lat > north + kMargin) return false;
+    if (west <= east) return lon >= west - kMargin && lon <= east + kMargin;
+    return lon >= west - kMargin || lon <= east + kMargin;  // across the antimeridian
+  };
+  double a = x, b = y;
+  if (m.swap_in) std::swap(a, b);
+  if (fits(a, b)) return {};
+  // The order the frame takes the file's numbers in: east first unless the (geographic) CRS or
+  // --axis-order says north first.
+  const bool reads_north_first = geographic ? m.north_first(m.src_h.get()) != m.swap_in : m.swap_in;
+  std::string cause;
+  if (fits(b, a)) {
+    cause = std::string("the axes look swapped (the point fits when its two numbers are exchanged): pass --axis-order ") +
+            (reads_north_first ? "east-north" : "north-east");
+  } else if (!geographic && std::fabs(x) <= 360 && std::fabs(y) <= 360) {
+    cause = "the numbers look like degrees under a projected (metre) label: name their CRS with -s_srs, e.g. "
+            "-s_srs EPSG:4326 (with --axis-order east-north if longitude comes first)";
+  } else if (geographic) {
+    cause = "the numbers do not look like degrees of that area (metres under a geographic label?): name their CRS "
+            "with -s_srs, e.g. -s_srs EPSG:25832";
+  } else {
+    cause = "the srsName does not fit the coordinates: name their CRS with -s_srs";
+  }
+  return "WARNING: the coordinates " + fmt(x) + ", " + fmt(y) + " lie far outside the area of use of " + m.source.text +
+         " (" + (area ? std::string(area).substr(0, 120) : std::string("?")) + ": longitude " + fmt(west) + " to " +
+         fmt(east) + ", latitude " + fmt(south) + " to " + fmt(north) + "); " + cause;
 }
 
 bool WorkingFrame::source_known() const { return impl_->src_known; }

@@ -125,7 +125,9 @@ class Reader final : public xml::Handler {
     } else {
       info_.kml_path = path_;
       kml_display = path_;
-      root_dir_ = fs::path(path_).parent_path().string();
+      // x.kml.gz is read as /vsigzip/x.kml.gz; its models and links are plain files beside it.
+      const bool gz = path_.rfind("/vsigzip/", 0) == 0;
+      root_dir_ = fs::path(gz ? path_.substr(9) : path_).parent_path().string();
       if (root_dir_.empty()) root_dir_ = ".";
     }
     visited_.insert(info_.kmz ? info_.kml_path.substr(archive_.size() + 1) : fs::path(path_).filename().string());

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdio>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -43,7 +44,9 @@ struct Part {
     Mesh mesh;                    // until its footprint is made
     std::size_t problem_pos = 0;  // where its problem goes among the others (problems.size() then)
     FootprintResult fp;           // fp.footprint.source_id names the building, made or not
+    std::string collapsed;        // set when georeferencing shrank it to nothing: why its footprint failed
   };
+  std::string collapsed_next;  // Placer -> FootprintMaker::add: the next slot's `collapsed`
   std::vector<Problem> problems;
   std::deque<Slot> slots;  // stable addresses: a footprint task holds a pointer to its slot
   std::size_t buildings_read = 0, buildings_dropped = 0;
@@ -91,6 +94,9 @@ class Placer {
         // --axis-order wins; else the order the format fixes (OGR: GDAL's data axis order), else the CRS's rule.
         const AxisOrder format_axis = read_info_ ? read_info_->source_axis : AxisOrder::Auto;
         crs.source_axis = options_.source_axis != AxisOrder::Auto ? options_.source_axis : format_axis;
+        // A CityGML srsName (not -s_srs) in the short form "EPSG:n": GDAL's GML convention, longitude first.
+        crs.gml_short_epsg_east_first =
+            options_.s_srs.empty() && (!read_info_ || read_info_->format == InputFormat::CityGml);
         // -s_srs / -a_srs win; else the CRS the format gives (OGR: the layer's), else the srsName read so far.
         frame_srs = !options_.s_srs.empty()                             ? options_.s_srs
                     : read_info_ && !read_info_->source_srs.empty() ? read_info_->source_srs
@@ -100,6 +106,9 @@ class Placer {
         else
           frame = std::make_unique<WorkingFrame>(frame_srs, crs, file_);
         if (decision_ && !frame->decided()) frame->decide((*decision_)[0], (*decision_)[1]);
+        // The file's first building (not a later chunk's: those come with decision_) against the
+        // area of use of the CRS it is read in: a wrong label says so once, naming that building.
+        check_area = !decision_ && !mesh.vertices.empty();
       }
       const bool georeferenced = in_working_crs_ || (frame && frame->source_known());
       if (georeferenced && !context_.unknown_frame_file.empty())
@@ -116,7 +125,20 @@ class Placer {
         decided_at = std::array<double, 2>{(lo_x + hi_x) / 2, (lo_y + hi_y) / 2};
         frame->decide((*decided_at)[0], (*decided_at)[1]);
       }
+      if (check_area) {
+        check_area = false;
+        const std::array<double, 4> box = extent_of(mesh);
+        const std::string warning = frame->area_of_use_mismatch((box[0] + box[2]) / 2, (box[1] + box[3]) / 2);
+        if (!warning.empty()) {
+          // Stage "read", not "georeference": a georeference- or footprint-stage problem naming a building
+          // means that building was dropped (the accounting in the problems layer); this one drops nothing.
+          part.problems.push_back({mesh.source_id, file_, "read", "CRS_OUTSIDE_AREA_OF_USE", warning});
+          area_warning = true;
+        }
+      }
+      const std::array<double, 4> before = extent_of(mesh);
       placed = !frame || frame->transform(mesh, &reason);
+      if (placed && frame && !mesh.vertices.empty()) note_collapse(mesh, before, part);
     } catch (const Error& e) {
       // The file's CRS cannot hold this building (EPSG:4326 on metres ...): the file's fault, so the
       // file stops here (the caller's catch); this building is named too, so that it is not lost.
@@ -131,7 +153,37 @@ class Placer {
     return placed;
   }
 
+  /// min x, min y, max x, max y of the mesh's vertices (all zero for none).
+  static std::array<double, 4> extent_of(const Mesh& mesh) {
+    if (mesh.vertices.empty()) return {0, 0, 0, 0};
+    std::array<double, 4> b{mesh.vertices[0].x, mesh.vertices[0].y, mesh.vertices[0].x, mesh.vertices[0].y};
+    for (const Point3& p : mesh.vertices) {
+      b[0] = std::min(b[0], p.x), b[1] = std::min(b[1], p.y);
+      b[2] = std::max(b[2], p.x), b[3] = std::max(b[3], p.y);
+    }
+    return b;
+  }
+
+  /// A building that had extent as read but is less than kCollapsed metres across once placed, where the
+  /// frame warned about the file's CRS or the transform shrank it a thousandfold (degrees read as metres,
+  /// a wrong label): its footprint's failure is then told as DEGENERATE_AFTER_GEOREFERENCING.
+  void note_collapse(const Mesh& mesh, const std::array<double, 4>& before, Part& part) const {
+    constexpr double kCollapsed = 0.05;  // metres: no building is 5 cm across
+    const std::array<double, 4> after = extent_of(mesh);
+    const double was = std::max(before[2] - before[0], before[3] - before[1]);
+    const double is = std::max(after[2] - after[0], after[3] - after[1]);
+    if (!(was > 0) || !(is < kCollapsed) || !(area_warning || is < was * 1e-3)) return;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%.3g units across as read, %.3g m across in the working CRS", was, is);
+    part.collapsed_next = "degenerate after georeferencing: the building is " + std::string(buf) + " (" +
+                          frame->source().text.substr(0, 120) + " read as " + frame->working_crs().name +
+                          "): its coordinates are not in the CRS the file names (degrees read as metres?); name "
+                          "their CRS with -s_srs";
+  }
+
   std::unique_ptr<WorkingFrame> frame;
+  bool check_area = false;    // the next mesh is the file's first: check it against the CRS's area of use
+  bool area_warning = false;  // that check warned
   std::string frame_srs;                             // the srsName the frame was made from
   std::optional<std::array<double, 2>> decided_at;   // set when this reading's first mesh fixed the working CRS
 
@@ -165,6 +217,8 @@ class FootprintMaker {
   void add(Mesh&& mesh, Part& part) {
     Part::Slot& slot = part.slots.emplace_back();
     slot.mesh = std::move(mesh);
+    slot.collapsed = std::move(part.collapsed_next);
+    part.collapsed_next.clear();
     slot.problem_pos = part.problems.size();
     if (!spawn_ || pending_.load(std::memory_order_relaxed) >= max_pending_) {
       make(slot);
@@ -205,7 +259,11 @@ void append(Part& part, const std::string& file, FileRead& out, Delivered& deliv
       continue;
     }
     for (; next < slot.problem_pos; ++next) out.problems.push_back(std::move(part.problems[next]));
-    out.problems.push_back({fp.footprint.source_id, file, "footprint", fp.code, fp.reason});
+    if (!slot.collapsed.empty())  // the reader's geometry was fine: say what broke it, not "no GroundSurface"
+      out.problems.push_back({fp.footprint.source_id, file, "georeference", "DEGENERATE_AFTER_GEOREFERENCING",
+                              slot.collapsed + " (the footprint step found: " + fp.reason + ")"});
+    else
+      out.problems.push_back({fp.footprint.source_id, file, "footprint", fp.code, fp.reason});
     ++out.buildings_dropped;
   }
   for (; next < part.problems.size(); ++next) out.problems.push_back(std::move(part.problems[next]));

@@ -128,17 +128,23 @@ namespace groundplan {
 namespace {
 
 TEST(Pipeline, AxisOrderOptionPlacesALonLatFileWhereItIs) {
-  // The OGC Jefferson Building sample says EPSG:4979 (lat, lon) but writes lon, lat. As written it
-  // lands at "latitude -77" (UTM of the far south); with --axis-order east-north, in Washington DC.
+  // The OGC Jefferson Building sample says "EPSG:4979" (EPSG's order: lat, lon) and writes lon, lat. GDAL's
+  // GML convention reads the short form "EPSG:n" longitude first, so as written it lands in Washington DC,
+  // as with --axis-order east-north; --axis-order north-east reads it latitude first, at "latitude -77"
+  // (UTM of the far south). Before that convention (issue 16), as written was the latter.
   gis::PipelineOptions options;
   options.inputs = {test::shared_data(
       "citygml-ogc-spec-samples/JeffersonBuilding_CityGML3.0_LOD1_with_xAL3_CommonTypes.gml")};
   const gis::PipelineResult as_written = gis::run_pipeline(options);
+  options.source_axis = gis::axis_order_from_string("north-east");
+  const gis::PipelineResult lat_first = gis::run_pipeline(options);
   options.source_axis = gis::axis_order_from_string("east-north");
   const gis::PipelineResult swapped = gis::run_pipeline(options);
   ASSERT_EQ(swapped.plans.size(), 1u);
   EXPECT_EQ(swapped.crs_name, "EPSG:32618");  // UTM 18N
-  EXPECT_NE(as_written.crs_name, swapped.crs_name);
+  EXPECT_EQ(as_written.crs_name, swapped.crs_name);
+  EXPECT_EQ(test::plan_keys(as_written.plans), test::plan_keys(swapped.plans));
+  EXPECT_NE(lat_first.crs_name, swapped.crs_name);
   const Point2 p = swapped.plans[0].polygon.outer[0];
   EXPECT_NEAR(p.x, 325700, 1000);
   EXPECT_NEAR(p.y, 4306600, 1000);

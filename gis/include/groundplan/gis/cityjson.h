@@ -42,6 +42,9 @@ struct CityJsonOptions {
   std::size_t max_line_bytes = std::size_t{1} << 30;
   /// As CityGmlOptions::max_abs_coordinate: a surface with a coordinate beyond it is dropped.
   double max_abs_coordinate = 1e9;
+  /// Bytes read (unpacked) after which reading stops with InputError; 0: no limit. read_any sets it for a
+  /// gzip input (ReadOptions::gzip_max_ratio), so that a gzip bomb cannot fill memory.
+  std::uint64_t max_bytes = 0;
 };
 
 struct CityJsonInfo {

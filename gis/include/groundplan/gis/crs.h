@@ -44,6 +44,10 @@ enum class AxisOrder {
 struct CrsOptions {
   std::string target_srs;            // -t_srs: any form parse_srs_name understands; empty = automatic
   AxisOrder source_axis = AxisOrder::Auto;
+  /// GDAL's GML convention (its GML driver, GML_CONSIDER_EPSG_AS_URN=NO): an srsName written in the short
+  /// form "EPSG:n" is read longitude/easting first even where the EPSG axis order is latitude first; the
+  /// URN and URL forms keep the authority order. Applies with source_axis Auto only; set for CityGML.
+  bool gml_short_epsg_east_first = false;
 };
 
 /// The working CRS, for the OGR layer.
@@ -79,6 +83,12 @@ class WorkingFrame {
 
   /// Transforms one point as written (for tests and anchors). Same rules as transform().
   bool transform_point(double& x, double& y) const;
+
+  /// Issue 16: when the point (x, y as written: a building's centre) lies far (> 2 degrees) outside the
+  /// source CRS's area of use (PROJ's proj_get_area_of_use), one sentence naming the point, the area, the
+  /// likely cause (axes swapped, degrees under a projected label, metres under a geographic one) and the
+  /// flag that mends it (--axis-order, -s_srs); empty when the point fits or PROJ knows no area.
+  std::string area_of_use_mismatch(double x_as_written, double y_as_written) const;
 
   bool source_known() const;            // false: no or local srsName; coordinates pass unchanged
   bool source_geographic() const;

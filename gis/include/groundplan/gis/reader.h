@@ -43,6 +43,11 @@ struct ReadOptions {
   OgrInputOptions ogr;          // any OGR vector source: layers, filter, ids, grouping (issue 22)
   std::function<void(std::uint64_t)> on_bytes;  // CityGML: told the bytes as they are read (progress); may be empty
   CityJsonOptions cityjson;     // limits (lod and lod_refinement above win over its own)
+  /// A gzip input (is_gzip_input_name) may expand to at most this many times its compressed size, and at
+  /// least gzip_min_bytes: a gzip bomb then stops with an InputError naming the file instead of filling
+  /// memory or disk (deflate reaches ~1000:1 on repeated bytes; CityGML and CityJSON give 5-30:1).
+  std::uint64_t gzip_max_ratio = 100;
+  std::uint64_t gzip_min_bytes = std::uint64_t{64} << 20;
 };
 
 struct ReadInfo {
@@ -72,6 +77,12 @@ InputFormat detect_format(const std::string& name, std::string_view head);
 /// .city.json .city.jsonl; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
 /// plain .json: a tile folder holds other JSON, e.g. 3D Tiles' tileset.json).
 bool is_input_name(const std::string& name);
+/// A gzip-compressed input by its name (issue 16): `x.gml.gz`, `x.citygml.gz`, `x.xml.gz`, `x.city.json.gz`,
+/// `x.city.jsonl.gz`, `x.kml.gz` (any case). Such a file is read through GDAL's /vsigzip/.
+bool is_gzip_input_name(const std::string& name);
+/// The path GDAL opens for `path`: "/vsigzip/" + path for a gzip input named as above (not already a
+/// /vsi path); else `path` itself.
+std::string open_path(const std::string& path);
 
 /// Reads one file of any supported format (a file the city formats do not recognise goes to GDAL's
 /// vector drivers: identified by content, so connection strings and /vsi paths work too). `info.format` and `info.in_working_crs` are set before
