@@ -16,7 +16,7 @@ mkdir -p "$work"
 src="$work/footprints_$n.gpkg"
 [ -f "$src" ] || /usr/bin/python3 "$here/gen_footprints_gpkg.py" "$src" "$n"
 median() { sort -n | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
-read_s() { /usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['timings_s']['read'])" "$1"; }
+read_s() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['timings_s']['read'])" "$1"; }
 echo "date=$(date -u +%FT%TZ) host=$(lscpu | sed -n 's/^Model name: *//p') cores=$(nproc) load=$(cut -d' ' -f1-3 /proc/loadavg)"
 for mode in "1 0" "$threads -1" "$threads 0"; do
   set -- $mode
@@ -26,10 +26,10 @@ for mode in "1 0" "$threads -1" "$threads 0"; do
     t0=$(date +%s.%N)
     "$build/bin/groundplan" -q --threads "$1" --read-range-features "$2" --stats "$work/stats_$1_$2.json" \
       -f CSV -lco GEOMETRY=AS_WKT "$work/out_$1_$2" "$src" ground_plans problems
-    walls+=("$(echo "$(date +%s.%N) - $t0" | bc)")
+    walls+=("$(python3 -c 'import sys; print(round(float(sys.argv[1]) - float(sys.argv[2]), 3))' "$(date +%s.%N)" "$t0")")
     reads+=("$(read_s "$work/stats_$1_$2.json")")
   done
-  chunks=$(/usr/bin/python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['reading']; print(r['chunks'], r['read_whole'])" "$work/stats_$1_$2.json")
+  chunks=$(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['reading']; print(r['chunks'], r['read_whole'])" "$work/stats_$1_$2.json")
   echo "threads=$1 read_range_features=$2 wall_median_s=$(printf '%s\n' "${walls[@]}" | median) read_median_s=$(printf '%s\n' "${reads[@]}" | median) ranges/read_whole=$chunks"
   echo "  wall runs: ${walls[*]}  read runs: ${reads[*]}"
 done
