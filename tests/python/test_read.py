@@ -88,6 +88,9 @@ def test_read_options_and_level_of_detail():
     cfd = groundplan.read(PLATEAU_SMALL, preset="cfd", threads=1)
     assert len(cfd.plans) <= len(exact.plans)
     assert set(cfd.footprints.columns) == set(exact.footprints.columns)
+    assert (cfd.problems["stage"] == "lod").any() or len(cfd.plans) < len(exact.plans)  # the preset did something
+    both = groundplan.read([PLATEAU_SMALL, LORUP])  # a list of inputs
+    assert len(both.footprints) == len(exact.footprints) + len(groundplan.read(LORUP).footprints)
 
 
 def test_read_errors_carry_the_cli_messages(tmp_path):
