@@ -21,6 +21,7 @@
 #include <pybind11/stl.h>
 
 #include <cpl_string.h>
+#include <geos_c.h>
 #include <gdal.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -32,6 +33,7 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -186,6 +188,42 @@ std::string polygon_wkb(const Polygon& poly) {
 }
 
 // ---------------------------------------------------------------------------------------------------------
+// GEOS geometries in (Shapely 1.8's fast path): Shapely hands the addresses of its GEOS geometries, read
+// here with the GEOS C API. Only used when Shapely's libgeos_c is the very library this module links (the
+// wrapper compares the addresses of GEOSversion), and the Python list of geometries keeps them alive.
+
+void geos_ring(GEOSContextHandle_t h, const GEOSGeometry* ring, Ring& out) {
+  const GEOSCoordSequence* seq = GEOSGeom_getCoordSeq_r(h, ring);
+  unsigned int n = 0;
+  if (!seq || !GEOSCoordSeq_getSize_r(h, seq, &n)) throw WkbError{"unreadable GEOS ring", false};
+  out.resize(n);
+  for (unsigned int i = 0; i < n; ++i) GEOSCoordSeq_getXY_r(h, seq, i, &out[i].x, &out[i].y);
+  if (out.size() > 1 && out.front() == out.back()) out.pop_back();
+}
+
+void geos_geometry(GEOSContextHandle_t h, const GEOSGeometry* g, std::vector<Polygon>& out, int depth) {
+  if (depth > 32) throw WkbError{"geometry nested too deep", false};
+  const int type = GEOSGeomTypeId_r(h, g);
+  if (type == GEOS_POLYGON) {
+    if (GEOSisEmpty_r(h, g) == 1) return;
+    Polygon poly;
+    geos_ring(h, GEOSGetExteriorRing_r(h, g), poly.outer);
+    const int holes = GEOSGetNumInteriorRings_r(h, g);
+    poly.holes.resize(holes > 0 ? holes : 0);
+    for (int k = 0; k < holes; ++k) geos_ring(h, GEOSGetInteriorRingN_r(h, g, k), poly.holes[k]);
+    out.push_back(std::move(poly));
+  } else if (type == GEOS_MULTIPOLYGON || type == GEOS_GEOMETRYCOLLECTION) {
+    const int n = GEOSGetNumGeometries_r(h, g);
+    for (int k = 0; k < n; ++k) geos_geometry(h, GEOSGetGeometryN_r(h, g, k), out, depth + 1);
+  } else {
+    static const char* names[] = {"Point", "LineString", "LinearRing", "Polygon", "MultiPoint", "MultiLineString"};
+    throw WkbError{std::string("a ") + (type >= 0 && type < 6 ? names[type] : "geometry of GEOS type " + std::to_string(type)) +
+                       " is not a polygon or multipolygon",
+                   true};
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
 // Running engine work off the Python thread, with Ctrl-C and a progress callback.
 
 struct Shared {
@@ -306,7 +344,9 @@ py::dict problem_dict(const Problem& p, bool with_index) {
 
 // ---------------------------------------------------------------------------------------------------------
 
-py::dict union_wkb(const py::list& wkbs, int threads, double resolution, const std::string& device, double snap,
+using ReadOne = std::function<void(std::size_t, std::vector<Polygon>&)>;  // throws WkbError
+
+py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, double resolution, const std::string& device, double snap,
                    double close_gaps, double simplify, double min_hole_area, double min_area,
                    const py::object& progress) {
   if (threads < 0) throw InvalidArgument("threads: " + std::to_string(threads) + " is not >= 1 (0 = all cores)");
@@ -323,19 +363,6 @@ py::dict union_wkb(const py::list& wkbs, int threads, double resolution, const s
   lod.simplify_m = simplify;
   lod.min_hole_area_m2 = min_hole_area;
   lod.min_area_m2 = min_area;
-
-  // The bytes objects stay alive in `wkbs` (held by the caller) while the worker reads them.
-  const std::size_t n = py::len(wkbs);
-  std::vector<std::pair<const char*, std::size_t>> views(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    PyObject* o = PyList_GET_ITEM(wkbs.ptr(), static_cast<Py_ssize_t>(i));
-    char* data = nullptr;
-    Py_ssize_t size = 0;
-    if (!PyBytes_Check(o) || PyBytes_AsStringAndSize(o, &data, &size) != 0)
-      throw py::type_error("geometry " + std::to_string(i) + ": expected WKB bytes, got " +
-                           std::string(py::str(py::type::handle_of(o).attr("__name__"))));
-    views[i] = {data, static_cast<std::size_t>(size)};
-  }
 
   struct Out {
     std::vector<GroundPlan> plans;
@@ -356,7 +383,7 @@ py::dict union_wkb(const py::list& wkbs, int threads, double resolution, const s
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
               fps[i].source_id = std::to_string(i);
               try {
-                WkbReader(views[i].first, views[i].second).read_footprint(fps[i].polygons);
+                read_one(i, fps[i].polygons);
               } catch (const WkbError& e) {
                 errors[i] = e;
               }
@@ -408,6 +435,42 @@ py::dict union_wkb(const py::list& wkbs, int threads, double resolution, const s
   r["problems"] = problems;
   r["timings"] = timings;
   return r;
+}
+
+#define GROUNDPLAN_UNION_PARAMS                                                                                \
+  int threads, double resolution, const std::string &device, double snap, double close_gaps, double simplify, \
+      double min_hole_area, double min_area, const py::object &progress
+#define GROUNDPLAN_UNION_ARGS threads, resolution, device, snap, close_gaps, simplify, min_hole_area, min_area, progress
+
+py::dict union_wkb(const py::list& wkbs, GROUNDPLAN_UNION_PARAMS) {
+  // The bytes objects stay alive in `wkbs` (held by the caller) while the worker reads them.
+  const std::size_t n = py::len(wkbs);
+  std::vector<std::pair<const char*, std::size_t>> views(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    PyObject* o = PyList_GET_ITEM(wkbs.ptr(), static_cast<Py_ssize_t>(i));
+    char* data = nullptr;
+    Py_ssize_t size = 0;
+    if (!PyBytes_Check(o) || PyBytes_AsStringAndSize(o, &data, &size) != 0)
+      throw py::type_error("geometry " + std::to_string(i) + ": expected WKB bytes, got " +
+                           std::string(py::str(py::type::handle_of(o).attr("__name__"))));
+    views[i] = {data, static_cast<std::size_t>(size)};
+  }
+  return union_inputs(
+      n, [&](std::size_t i, std::vector<Polygon>& out) { WkbReader(views[i].first, views[i].second).read_footprint(out); },
+      GROUNDPLAN_UNION_ARGS);
+}
+
+py::dict union_geos(const std::vector<std::uintptr_t>& addresses, GROUNDPLAN_UNION_PARAMS) {
+  return union_inputs(
+      addresses.size(),
+      [&](std::size_t i, std::vector<Polygon>& out) {
+        thread_local struct Handle {
+          GEOSContextHandle_t h = GEOS_init_r();
+          ~Handle() { GEOS_finish_r(h); }
+        } handle;
+        geos_geometry(handle.h, reinterpret_cast<const GEOSGeometry*>(addresses[i]), out, 0);
+      },
+      GROUNDPLAN_UNION_ARGS);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -513,6 +576,12 @@ PYBIND11_MODULE(_groundplan, m) {
         py::arg("snap"), py::arg("close_gaps"), py::arg("simplify"), py::arg("min_hole_area"), py::arg("min_area"),
         py::arg("progress"),
         "union_wkb(wkbs: list[bytes], ...) -> dict(plans=[WKB], members=[[int]], areas=[float], problems=[dict], timings=dict)");
+  m.def("union_geos", &union_geos, py::arg("addresses"), py::arg("threads"), py::arg("resolution"), py::arg("device"),
+        py::arg("snap"), py::arg("close_gaps"), py::arg("simplify"), py::arg("min_hole_area"), py::arg("min_area"),
+        py::arg("progress"),
+        "union_geos(addresses: list[int], ...): as union_wkb, from the addresses of GEOS geometries of the same libgeos_c");
+  m.def("geos_version_address", [] { return reinterpret_cast<std::uintptr_t>(&GEOSversion); },
+        "The address of GEOSversion in the libgeos_c this module uses (Shapely's must be the same for union_geos)");
   m.def("read", &read_inputs, py::arg("inputs"), py::arg("options"), py::arg("progress"),
         "read(inputs: list[str], options: dict[str, str], progress) -> dict(layers=..., crs_wkt=..., crs_name=..., stats=...)");
 }

@@ -12,6 +12,15 @@ from shapely.ops import unary_union
 from conftest import BUILD_DIR, PLATEAU, LORUP, block_city, city, groundplan, symdiff_rel
 
 
+@pytest.fixture(params=["native", "wkb"])
+def route(request, monkeypatch):
+    """Each test once through the route the wrapper picks (Shapely 1.x on Debian: GEOS addresses) and once
+    through WKB bytes (Shapely 2, or a Shapely with a libgeos_c of its own)."""
+    if request.param == "wkb":
+        monkeypatch.setattr(groundplan, "_geos_addresses", lambda geoms: None)
+    return request.param
+
+
 def check_against_geos(geoms, result):
     ref = unary_union(geoms)
     got = MultiPolygon(result.plans) if len(result.plans) != 1 else result.plans[0]
@@ -36,16 +45,22 @@ def check_members(geoms, result, skip=()):
         assert g.difference(plan).area <= 1e-9 * g.area, f"plan {seen[i]} does not cover input {i}"
 
 
-def test_generated_city_equals_unary_union():
+def test_generated_city_equals_unary_union(route):
     geoms = city(3000)
     r = groundplan.union(geoms)
     check_against_geos(geoms, r)
     check_members(geoms, r)
     assert r.problems == []
+    import shapely
+
+    if route == "wkb" or shapely.__version__ >= "2":
+        assert r.timings["route"] == "wkb"
+    else:  # Debian's Shapely 1.8 shares this module's libgeos_c
+        assert r.timings["route"] == "geos"
     assert sum(r.areas) == pytest.approx(unary_union(geoms).area, rel=1e-9)
 
 
-def test_block_city_equals_unary_union():
+def test_block_city_equals_unary_union(route):
     geoms = block_city(5000, seed=4)  # party walls shared exactly, wings at angles
     r = groundplan.union(geoms)
     check_against_geos(geoms, r)
@@ -84,7 +99,7 @@ def test_geoseries_and_wkb_input():
     check_against_geos(geoms, r1)
 
 
-def test_invalid_input_becomes_problems():
+def test_invalid_input_becomes_problems(route):
     nan = float("nan")
     square = Polygon([(0, 0), (10, 0), (10, 10), (0, 10)])
     bowtie = Polygon([(20, 0), (30, 10), (30, 0), (20, 10)])  # self-crossing: even-odd gives two triangles
@@ -105,7 +120,7 @@ def test_invalid_input_becomes_problems():
     assert set(in_plans) | set(codes) == set(range(len(geoms)))
 
 
-def test_multipolygon_and_holes():
+def test_multipolygon_and_holes(route):
     outer = Polygon([(0, 0), (20, 0), (20, 20), (0, 20)], [[(5, 5), (15, 5), (15, 15), (5, 15)]])
     mp = MultiPolygon([Polygon([(30, 0), (40, 0), (40, 10), (30, 10)]), Polygon([(50, 0), (60, 0), (60, 10), (50, 10)])])
     r = groundplan.union([outer, mp])
@@ -115,7 +130,7 @@ def test_multipolygon_and_holes():
     assert sorted(holes) == [0, 0, 1]
 
 
-def test_not_polygonal_raises_type_error():
+def test_not_polygonal_raises_type_error(route):
     from shapely.geometry import LineString, Point
 
     with pytest.raises(TypeError, match="geometry 1: a LineString"):
