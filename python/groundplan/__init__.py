@@ -85,6 +85,9 @@ def _to_wkb(geometries: Iterable[Any]) -> List[bytes]:
     """Shapely geometries (a sequence, GeoSeries or array) -> a list of WKB bytes, vectorised where Shapely can."""
     if hasattr(geometries, "geom_type") and hasattr(geometries, "values"):  # GeoSeries: its positions, not its index
         geometries = list(geometries.values)
+    geometries = list(geometries)
+    if all(isinstance(g, (bytes, bytearray)) for g in geometries):  # WKB already
+        return [bytes(g) for g in geometries]
     if _shapely_major() >= 2:
         import numpy as np
         import shapely

@@ -297,25 +297,32 @@ Result run_cancellable(Work&& work, const py::object& callback) {
       s.cv.notify_all();
     });
   }
-  for (;;) {
-    bool done;
-    {
-      py::gil_scoped_release release;
-      std::unique_lock<std::mutex> lock(s.mutex);
-      s.cv.wait_for(lock, std::chrono::milliseconds(20), [&] { return s.done; });
-      done = s.done;
-    }
-    if (!py_error && PyErr_CheckSignals() != 0) {  // Ctrl-C: KeyboardInterrupt is now set
-      py_error.emplace();
-      s.cancel = true;
-    }
-    forward();
-    if (done) break;
-  }
-  {
+  auto join = [&] {
     py::gil_scoped_release release;
     worker.join();
+  };
+  try {
+    for (;;) {
+      bool done;
+      {
+        py::gil_scoped_release release;
+        std::unique_lock<std::mutex> lock(s.mutex);
+        s.cv.wait_for(lock, std::chrono::milliseconds(20), [&] { return s.done; });
+        done = s.done;
+      }
+      if (!py_error && PyErr_CheckSignals() != 0) {  // Ctrl-C: KeyboardInterrupt is now set
+        py_error.emplace();
+        s.cancel = true;
+      }
+      forward();
+      if (done) break;
+    }
+  } catch (...) {  // never leave with the worker running (std::thread's destructor would terminate)
+    s.cancel = true;
+    join();
+    throw;
   }
+  join();
   if (py_error) throw *py_error;
   if (error) std::rethrow_exception(error);
   forward();  // the last report (1.0) when it came after the last wake-up
