@@ -23,6 +23,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev python3-pytest
   # the GeoPandas/Shapely baseline of the OGR-input benchmark (issue 22, tests/bench/ogr_input_bench.sh)
   python3-geopandas
+  # the Python module (issue 23, python/): pybind11 and the headers to build it; Shapely, GeoPandas (Fiona,
+  # pyproj) for its wrapper and tests. Debian bookworm has no pyogrio: its test skips.
+  python3-dev pybind11-dev python3-shapely python3-fiona python3-pyproj python3-numpy
   # fuzzing (libFuzzer with clang; tests/fuzz) and the sanitizer runtime's symbolizer
   clang libclang-rt-14-dev llvm
 )
