@@ -12,39 +12,17 @@ Usage: PYTHONPATH=build/python python3 tests/bench/python_union_bench.py [--n 60
        [--threads 0] [--input CITYGML_OR_FOLDER ...]   (--input: real footprints read by groundplan.read)
 """
 import argparse
-import math
-import random
+import pathlib
 import statistics
+import sys
 import time
 
 import groundplan
 import shapely
-from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
-
-def city(n, seed=23, x0=500000.0, y0=5400000.0):
-    """Rows of houses with shared walls and overlapping wings on a grid of blocks (like bench_union.cpp's
-    synthetic city: buildings touch, overlap and stand apart), in UTM-like coordinates."""
-    rng = random.Random(seed)
-    out = []
-    per_side = int(math.sqrt(n / 24.0)) + 1
-    b = 0
-    while len(out) < n:
-        bx, by = x0 + (b % per_side) * 120.0, y0 + (b // per_side) * 120.0
-        b += 1
-        for row in range(3):
-            x = bx
-            y = by + row * 35.0
-            for _ in range(8):
-                w, d = rng.uniform(6, 12), rng.uniform(9, 14)
-                out.append(Polygon([(x, y), (x + w, y), (x + w, y + d), (x, y + d)]))  # party walls: exact
-                if rng.random() < 0.3:  # a rotated wing overlapping the back
-                    cx, cy, a = x + w / 2, y + d + 1.5, rng.uniform(0, math.pi)
-                    c, s = math.cos(a), math.sin(a)
-                    out.append(Polygon([(cx + c * u - s * v, cy + s * u + c * v) for u, v in ((-2, -3), (2, -3), (2, 3), (-2, 3))]))
-                x += w
-    return out[:n]
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python"))
+from synthetic_city import block_city  # noqa: E402  (the tests' generator)
 
 
 def median_of(runs, key):
@@ -62,7 +40,7 @@ def main():
         geoms = [g for g in groundplan.read(a.input).footprints.geometry if g.is_valid and not g.is_empty]
         what = f"{len(geoms)} valid real footprints from {' '.join(a.input)}"
     else:
-        geoms = city(a.n)
+        geoms = block_city(a.n)
         what = f"{len(geoms)} generated footprints"
     print(f"# {what}; shapely {shapely.__version__}, GEOS {shapely.geos.geos_version_string if hasattr(shapely, 'geos') else shapely.geos_version_string}")
 
