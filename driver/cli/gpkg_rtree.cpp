@@ -12,6 +12,9 @@
 // entry is the one GDAL's own index would hold.
 #include "gpkg_rtree.h"
 
+#include <cpl_error.h>
+#include <gdal.h>
+#include <ogr_api.h>
 #include <ogr_geometry.h>
 #include <sqlite3.h>
 #include <tbb/parallel_for.h>
@@ -469,6 +472,26 @@ RtreeBuild build_gpkg_rtrees(const std::string& path, const std::vector<std::str
     out.error = e.what();
   }
   return out;
+}
+
+bool index_new_gpkg(const std::string& path, int threads, RtreeBuild& built, bool packed) {
+  if (packed) {
+    built = build_gpkg_rtrees(path, {}, threads);
+    if (built.error.empty()) return true;
+  }
+  built.by_gdal = true;
+  GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+  if (!ds) return false;
+  for (const std::string& table : gpkg_unindexed_tables(path)) {
+    OGRLayerH layer = GDALDatasetGetLayerByName(ds, table.c_str());
+    const char* geom = layer ? OGR_L_GetGeometryColumn(layer) : nullptr;
+    if (!geom || !*geom) continue;
+    const std::string sql = "SELECT CreateSpatialIndex(" + lit(table) + ", " + lit(geom) + ")";
+    if (OGRLayerH r = GDALDatasetExecuteSQL(ds, sql.c_str(), nullptr, nullptr)) GDALDatasetReleaseResultSet(ds, r);
+  }
+  CPLErrorReset();
+  GDALClose(ds);
+  return CPLGetLastErrorType() < CE_Failure && gpkg_unindexed_tables(path).empty();
 }
 
 }  // namespace groundplan::cli

@@ -24,6 +24,7 @@ std::vector<std::string> gpkg_unindexed_tables(const std::string& path);
 struct RtreeBuild {
   std::size_t tables = 0;   // indexes built
   std::size_t entries = 0;  // features indexed (non-empty geometries)
+  bool by_gdal = false;     // packing failed (error says why) and GDAL's CreateSpatialIndex built them instead
   double read_s = 0, write_s = 0, commit_s = 0;  // reading the boxes, packing and writing the tree, committing
   std::string error;        // non-empty: what failed (that table's transaction was rolled back)
 };
@@ -32,5 +33,11 @@ struct RtreeBuild {
 /// already there without one before this run: the user's choice), reading the geometries on `threads`
 /// threads. Stops at the first failure.
 RtreeBuild build_gpkg_rtrees(const std::string& path, const std::vector<std::string>& skip, int threads);
+
+/// What the CLI calls after writing a new GeoPackage: build_gpkg_rtrees for every table without an index,
+/// and where that fails, GDAL's own CreateSpatialIndex for the tables still without one, so that the file
+/// never lacks the index a GDAL user expects. `packed = false` goes straight to GDAL's way. False when a
+/// table is left without an index.
+bool index_new_gpkg(const std::string& path, int threads, RtreeBuild& built, bool packed = true);
 
 }  // namespace groundplan::cli

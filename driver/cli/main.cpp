@@ -291,8 +291,9 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
                   {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole}};
   j["raster_backend"] = result.raster_backend;
   if (index)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
-    j["spatial_index"] = {{"tables", index->tables}, {"entries", index->entries}, {"read_s", index->read_s},
-                          {"write_s", index->write_s}, {"commit_s", index->commit_s}, {"error", index->error}};
+    j["spatial_index"] = {{"tables", index->tables},     {"entries", index->entries}, {"read_s", index->read_s},
+                          {"write_s", index->write_s},   {"commit_s", index->commit_s}, {"error", index->error},
+                          {"by_gdal", index->by_gdal}};
   if (lod.any()) j["level_of_detail"] = lod_json(lod, result.lod_stats);
   if (verify) j["verify"] = *verify;
   std::ofstream f(path);
@@ -472,25 +473,12 @@ int run(int argc, char** argv) {
   groundplan::cli::RtreeBuild built;
   if (write_ok && own_index) {
     const auto t_index = clock::now();
-    built = groundplan::cli::build_gpkg_rtrees(
-        ogr.dst, {}, static_cast<int>(groundplan::gis::thread_count(options.threads)));
-    if (!built.error.empty()) {
-      // Never leave a GeoPackage without the index a GDAL user expects: GDAL's own way, slower.
-      std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL builds it instead\n",
+    const bool indexed = groundplan::cli::index_new_gpkg(
+        ogr.dst, static_cast<int>(groundplan::gis::thread_count(options.threads)), built);
+    if (built.by_gdal)
+      std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL built it instead\n",
                    built.error.c_str());
-      GDALDatasetH out = GDALOpenEx(ogr.dst.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
-      for (const std::string& table : groundplan::cli::gpkg_unindexed_tables(ogr.dst)) {
-        OGRLayerH layer = out ? GDALDatasetGetLayerByName(out, table.c_str()) : nullptr;
-        const char* geom = layer ? OGR_L_GetGeometryColumn(layer) : nullptr;
-        if (!geom) continue;
-        const std::string sql = "SELECT CreateSpatialIndex('" + table + "', '" + geom + "')";
-        if (OGRLayerH r = GDALDatasetExecuteSQL(out, sql.c_str(), nullptr, nullptr)) GDALDatasetReleaseResultSet(out, r);
-      }
-      CPLErrorReset();
-      if (out) GDALClose(out);
-      if (CPLGetLastErrorType() >= CE_Failure || !groundplan::cli::gpkg_unindexed_tables(ogr.dst).empty())
-        std::fprintf(stderr, "groundplan: warning: %s has no spatial index\n", ogr.dst.c_str());
-    }
+    if (!indexed) std::fprintf(stderr, "groundplan: warning: %s has no spatial index\n", ogr.dst.c_str());
     index_s = seconds_since(t_index);
   }
 
