@@ -12,6 +12,8 @@
 #     25 s); the whole e2e under sanitizers takes ~10 min on 2 cores (GROUNDPLAN_SANITIZE_E2E=all).
 #     test_package.py is never run here: cpack of a sanitizer build under LD_PRELOAD passes 10 minutes
 #     and tests packaging, not memory safety.
+#  3. the Python module's tests (tests/python, where the module was built), the same way as 2: the
+#     extension is loaded into python3, so it cannot run in pass 1 (ASan would abort: not first in the process).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash packaging/install-deps.sh
@@ -23,7 +25,7 @@ cmake --build "$build" -j"$(nproc)"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 exclude=${GROUNDPLAN_SANITIZE_LABELS_EXCLUDE:-}
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
-  ctest --test-dir "$build" --output-on-failure -j"$(nproc)" --timeout 1800 -LE "e2e${exclude:+|$exclude}"
+  ctest --test-dir "$build" --output-on-failure -j"$(nproc)" --timeout 1800 -LE "e2e|python${exclude:+|$exclude}"
 
 preload="$(gcc -print-file-name=libasan.so):$(gcc -print-file-name=libubsan.so)"
 if [ "${GROUNDPLAN_SANITIZE_E2E:-bad-input}" = all ]; then
@@ -34,3 +36,8 @@ fi
 GROUNDPLAN_BIN="$PWD/$build/bin/groundplan" GDAL_DRIVER_PATH="$PWD/$build/gdalplugins" GROUNDPLAN_SOURCE_DIR="$PWD" \
   GROUNDPLAN_BUILD_DIR="$PWD/$build" LD_PRELOAD="$preload" ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
   /usr/bin/python3 -m pytest -q -p no:cacheprovider "${e2e[@]}"
+if [ -d "$build/python/groundplan" ]; then
+  GROUNDPLAN_BIN="$PWD/$build/bin/groundplan" GDAL_DRIVER_PATH="$PWD/$build/gdalplugins" GROUNDPLAN_SOURCE_DIR="$PWD" \
+    GROUNDPLAN_BUILD_DIR="$PWD/$build" PYTHONPATH="$PWD/$build/python" LD_PRELOAD="$preload" \
+    ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/python
+fi
