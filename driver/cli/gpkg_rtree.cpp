@@ -449,13 +449,12 @@ std::vector<std::string> gpkg_unindexed_tables(const std::string& path) {
   return out;
 }
 
-RtreeBuild build_gpkg_rtrees(const std::string& path, const std::vector<std::string>& skip, int threads) {
+RtreeBuild build_gpkg_rtrees(const std::string& path, int threads) {
   RtreeBuild out;
   try {
     const Db db(path);
     db.exec("PRAGMA cache_size = -65536");  // 64 MiB: the tree's pages are written once, not evicted and re-read
     for (const GeomColumn& gc : unindexed(db)) {
-      if (std::find(skip.begin(), skip.end(), gc.table) != skip.end()) continue;
       db.exec("BEGIN");
       try {
         out.entries += build_one(path, db, gc, threads, out);
@@ -476,7 +475,7 @@ RtreeBuild build_gpkg_rtrees(const std::string& path, const std::vector<std::str
 
 bool index_new_gpkg(const std::string& path, int threads, RtreeBuild& built, bool packed) {
   if (packed) {
-    built = build_gpkg_rtrees(path, {}, threads);
+    built = build_gpkg_rtrees(path, threads);
     if (built.error.empty()) return true;
   }
   built.by_gdal = true;

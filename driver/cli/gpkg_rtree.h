@@ -29,10 +29,9 @@ struct RtreeBuild {
   std::string error;        // non-empty: what failed (that table's transaction was rolled back)
 };
 
-/// Builds the spatial index of every table that has none, except those in `skip` (tables that were
-/// already there without one before this run: the user's choice), reading the geometries on `threads`
-/// threads. Stops at the first failure.
-RtreeBuild build_gpkg_rtrees(const std::string& path, const std::vector<std::string>& skip, int threads);
+/// Builds the spatial index of every table that has none (the CLI calls it on a GeoPackage it has just
+/// created), reading the geometries on `threads` threads. Stops at the first failure.
+RtreeBuild build_gpkg_rtrees(const std::string& path, int threads);
 
 /// What the CLI calls after writing a new GeoPackage: build_gpkg_rtrees for every table without an index,
 /// and where that fails, GDAL's own CreateSpatialIndex for the tables still without one, so that the file

@@ -129,7 +129,7 @@ TEST(GpkgRtree, PackedIndexHoldsEveryNonEmptyBoxRoundedOutwards) {
   const std::string path = (dir.path / "parts.gpkg").string();
   const std::vector<Box> boxes = write_gpkg(path, 5000);  // ~100 leaves: three levels of 51-cell nodes
   ASSERT_EQ(cli::gpkg_unindexed_tables(path), std::vector<std::string>{"parts"});
-  const cli::RtreeBuild built = cli::build_gpkg_rtrees(path, {}, 3);
+  const cli::RtreeBuild built = cli::build_gpkg_rtrees(path, 3);
   ASSERT_EQ(built.error, "");
   EXPECT_EQ(built.tables, 1u);
   EXPECT_EQ(built.entries, boxes.size());
@@ -165,7 +165,7 @@ TEST(GpkgRtree, AFailureLeavesNoHalfBuiltIndex) {
   const std::string bad_blob = (dir.path / "bad_blob.gpkg").string();
   write_gpkg(bad_blob, 300);
   query(bad_blob, "UPDATE parts SET geom = X'0001020304' WHERE fid = 123", /*update=*/true);
-  cli::RtreeBuild built = cli::build_gpkg_rtrees(bad_blob, {}, 2);
+  cli::RtreeBuild built = cli::build_gpkg_rtrees(bad_blob, 2);
   EXPECT_NE(built.error.find("feature 123"), std::string::npos) << built.error;
   EXPECT_EQ(built.tables, 0u);
   EXPECT_EQ(cli::gpkg_unindexed_tables(bad_blob), std::vector<std::string>{"parts"});
@@ -175,7 +175,7 @@ TEST(GpkgRtree, AFailureLeavesNoHalfBuiltIndex) {
   const std::string stale = (dir.path / "stale_trigger.gpkg").string();
   write_gpkg(stale, 300);
   query(stale, "CREATE TRIGGER rtree_parts_geom_delete AFTER DELETE ON parts BEGIN SELECT 1; END", /*update=*/true);
-  built = cli::build_gpkg_rtrees(stale, {}, 2);
+  built = cli::build_gpkg_rtrees(stale, 2);
   EXPECT_NE(built.error.find("rtree_parts_geom_delete"), std::string::npos) << built.error;
   EXPECT_EQ(built.tables, 0u);
   EXPECT_EQ(rtree_tables(stale), 0.0);
