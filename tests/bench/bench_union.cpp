@@ -1,17 +1,23 @@
 // SPDX-License-Identifier: MIT
-// Union benchmark (issue 3): this engine against GEOS UnaryUnion (and GEOSCoverageUnion where the
-// input is a valid coverage) on identical synthetic footprints, in one process per (engine, size)
-// so that peak memory (getrusage ru_maxrss) belongs to one engine.
+// Union benchmark (issue 3): this engine against GEOS UnaryUnion, GEOS DisjointSubsetUnion (GEOS >= 3.12,
+// the honest baseline: it unions each group of touching polygons on its own, as we do) and
+// GEOSCoverageUnion where the input is a valid coverage, on identical synthetic footprints, in one
+// process per (engine, size) so that peak memory (getrusage ru_maxrss) belongs to one engine.
 //
-//   bench_union --n 6000 --engine ours|geos|coverage [--runs 5] [--seed 1] [--threads 0] [--coverage]
+//   bench_union --n 6000 --engine ours|geos|dsu|coverage [--runs 5] [--seed 1] [--threads 0] [--coverage]
 //   bench_union --n 6000 --verify [--coverage]     (compare our plans with GEOS UnaryUnion, exit 1 if not)
 // prints one line: engine n runs median_wall_s min_wall_s max_wall_s median_cpu_s plans peak_rss_mib
 // input_rss_mib min_cpu_s (input_rss: after generating the footprints, before the first union; on a
 // shared machine the least-disturbed run, min_cpu_s, is the best estimate of the unloaded cost)
 // tests/bench/run_bench.sh runs the whole matrix and prints ratios.
+//
+// DisjointSubsetUnion is looked up at run time (dlsym), because Debian bookworm's GEOS is 3.11: the same
+// binary, started with LD_LIBRARY_PATH pointing at a newer libgeos_c.so.1 (the C API's ABI is stable),
+// measures it; with 3.11 `--engine dsu` exits 3 and says why. The GEOS version in use goes to stderr.
 #include <groundplan/gis/geos_reference.h>
 #include <groundplan/ground_plans.h>
 
+#include <dlfcn.h>
 #include <geos_c.h>
 
 #include <algorithm>
@@ -33,8 +39,11 @@ using groundplan::bench::peak_rss_mib;
 
 void quiet(const char*, ...) {}
 
-/// GEOS CoverageUnion (GEOS >= 3.8) of all footprint polygons; returns the number of polygons.
-std::size_t geos_coverage_union(const std::vector<groundplan::Footprint>& fps) {
+using CollectionUnion = GEOSGeometry* (*)(GEOSContextHandle_t, const GEOSGeometry*);
+
+/// `op` (GEOSCoverageUnion_r, GEOSDisjointSubsetUnion_r) of all footprint polygons as one MultiPolygon;
+/// returns the number of polygons of the result.
+std::size_t geos_collection_union(const std::vector<groundplan::Footprint>& fps, CollectionUnion op) {
   GEOSContextHandle_t h = GEOS_init_r();
   GEOSContext_setNoticeHandler_r(h, quiet);
   GEOSContext_setErrorHandler_r(h, quiet);
@@ -53,12 +62,17 @@ std::size_t geos_coverage_union(const std::vector<groundplan::Footprint>& fps) {
     }
   GEOSGeometry* coll =
       GEOSGeom_createCollection_r(h, GEOS_MULTIPOLYGON, polys.data(), static_cast<unsigned>(polys.size()));
-  GEOSGeometry* u = GEOSCoverageUnion_r(h, coll);
+  GEOSGeometry* u = op(h, coll);
   std::size_t n = u ? static_cast<std::size_t>(GEOSGetNumGeometries_r(h, u)) : 0;
   if (u) GEOSGeom_destroy_r(h, u);
   GEOSGeom_destroy_r(h, coll);
   GEOS_finish_r(h);
   return n;
+}
+
+/// GEOSDisjointSubsetUnion_r of the libgeos_c loaded at run time, or nullptr before GEOS 3.12.
+CollectionUnion disjoint_subset_union() {
+  return reinterpret_cast<CollectionUnion>(dlsym(RTLD_DEFAULT, "GEOSDisjointSubsetUnion_r"));
 }
 
 }  // namespace
@@ -80,9 +94,16 @@ int main(int argc, char** argv) {
     else if (a == "--coverage") coverage = true;
     else if (a == "--verify") verify = true;
     else {
-      std::fprintf(stderr, "usage: %s --n N --engine ours|geos|coverage [--runs R] [--seed S] [--threads T] [--coverage]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s --n N --engine ours|geos|dsu|coverage [--runs R] [--seed S] [--threads T] [--coverage]\n", argv[0]);
       return 2;
     }
+  }
+  std::fprintf(stderr, "GEOS %s\n", GEOSversion());
+  const CollectionUnion dsu = disjoint_subset_union();
+  if (engine == "dsu" && !dsu) {
+    std::fprintf(stderr, "--engine dsu: GEOSDisjointSubsetUnion_r needs GEOS >= 3.12, loaded %s; put a newer "
+                 "libgeos_c.so.1 on LD_LIBRARY_PATH\n", GEOSversion());
+    return 3;
   }
   const auto fps = groundplan::testing::synthetic_city(n, seed, coverage);
   const double input_rss = peak_rss_mib();
@@ -108,8 +129,10 @@ int main(int argc, char** argv) {
       plans = groundplan::build_ground_plans(fps, p, problems).size();
     } else if (engine == "geos") {
       plans = groundplan::gis::geos_union(fps).size();
+    } else if (engine == "dsu") {
+      plans = geos_collection_union(fps, dsu);
     } else if (engine == "coverage") {
-      plans = geos_coverage_union(fps);
+      plans = geos_collection_union(fps, GEOSCoverageUnion_r);
     } else {
       std::fprintf(stderr, "unknown engine %s\n", engine.c_str());
       return 2;
