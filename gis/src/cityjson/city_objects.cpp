@@ -103,24 +103,27 @@ class GeometryWalker {
       return;
     }
     dom::array children = boundaries.get_array();
+    // The semantic values run beside the boundaries: one iterator each (dom::array::at is a linear scan,
+    // which made a MultiSurface of n surfaces cost n^2).
     dom::array value_children;
     const bool have_values = values && values->get_array().get(value_children) == simdjson::SUCCESS;
-    std::size_t i = 0;
+    auto value_it = have_values ? value_children.begin() : dom::array::iterator{};
+    const auto value_end = have_values ? value_children.end() : dom::array::iterator{};
     for (dom::element child : children) {
       std::optional<dom::element> v;
-      dom::element ve;
-      if (have_values && value_children.at(i).get(ve) == simdjson::SUCCESS) v = ve;
+      if (have_values && value_it != value_end) {
+        v = *value_it;
+        ++value_it;
+      }
       walk(child, v, levels - 1);
-      ++i;
     }
   }
 
  private:
-  bool vertex(std::uint64_t index, Point3& out, std::string& why) const {
-    if (index >= src_.points->size()) {
-      why = "BAD_VERTEX_INDEX";
-      return false;
-    }
+  enum class VertexDefect { None, BadIndex, NotFinite, OutOfRange };
+
+  VertexDefect vertex(std::uint64_t index, Point3& out) const {
+    if (index >= src_.points->size()) return VertexDefect::BadIndex;
     Point3 p = (*src_.points)[index];
     if (src_.matrix) {
       const double* m = src_.matrix;
@@ -128,37 +131,70 @@ class GeometryWalker {
                  m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7] + src_.ref.y,
                  m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11] + src_.ref.z};
     }
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      why = "NOT_FINITE";
-      return false;
-    }
-    if (std::fabs(p.x) > max_abs_ || std::fabs(p.y) > max_abs_ || std::fabs(p.z) > max_abs_) {
-      why = "COORDINATE_OUT_OF_RANGE";
-      return false;
-    }
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return VertexDefect::NotFinite;
+    if (std::fabs(p.x) > max_abs_ || std::fabs(p.y) > max_abs_ || std::fabs(p.z) > max_abs_)
+      return VertexDefect::OutOfRange;
     out = p;
-    return true;
+    return VertexDefect::None;
   }
 
+  /// Rings and face go straight into the mesh; a surface dropped half way (a bad index, a too short outer
+  /// ring, malformed JSON thrown out of the walk) is taken out again when the writer goes out of scope.
+  class FaceWriter {
+   public:
+    explicit FaceWriter(Mesh& m)
+        : m_(m), vertices_(m.vertices.size()), indices_(m.indices.size()), rings_(m.ring_offsets.size()) {}
+    ~FaceWriter() {
+      if (done_) return;
+      m_.vertices.resize(vertices_);
+      m_.indices.resize(indices_);
+      m_.ring_offsets.resize(rings_);
+    }
+    std::size_t ring_mark() const { return m_.vertices.size(); }
+    void point(const Point3& p) {
+      m_.indices.push_back(static_cast<std::uint32_t>(m_.vertices.size()));
+      m_.vertices.push_back(p);
+    }
+    void end_ring() { m_.ring_offsets.push_back(static_cast<std::uint32_t>(m_.indices.size())); }
+    void drop_ring(std::size_t mark) {  // the points since ring_mark(), of a ring not ended
+      m_.indices.resize(m_.indices.size() - (m_.vertices.size() - mark));
+      m_.vertices.resize(mark);
+    }
+    std::size_t rings() const { return m_.ring_offsets.size() - rings_; }
+    void end_face(SurfaceKind kind, std::uint8_t lod) {
+      MeshFace f;
+      f.first_ring = static_cast<std::uint32_t>(rings_ - 1);
+      f.ring_count = static_cast<std::uint32_t>(rings());
+      f.kind = kind;
+      f.lod = lod;
+      m_.faces.push_back(f);
+      done_ = true;
+    }
+
+   private:
+    Mesh& m_;
+    std::size_t vertices_, indices_, rings_;
+    bool done_ = false;
+  };
+
   void surface(dom::element s, SurfaceKind kind) {
-    rings_.clear();
+    FaceWriter face(mesh_);
     std::size_t ring_no = 0;
     for (dom::element ring : s.get_array()) {
-      std::vector<Point3> pts;
+      const std::size_t mark = face.ring_mark();
       for (dom::element idx : ring.get_array()) {
         std::uint64_t i = 0;
-        std::string why;
         Point3 p;
         if (idx.get_uint64().get(i) != simdjson::SUCCESS) {
           defects_.add("BAD_VERTEX_INDEX", "a vertex index is not a non-negative integer; its surface is dropped");
           return;
         }
-        if (!vertex(i, p, why)) {
-          if (why == "BAD_VERTEX_INDEX")
+        if (const VertexDefect d = vertex(i, p); d != VertexDefect::None) {
+          if (d == VertexDefect::BadIndex)
             defects_.add("BAD_VERTEX_INDEX", "vertex index " + std::to_string(i) + " is out of range (" +
                                                  std::to_string(src_.points->size()) +
                                                  " vertices); its surface is dropped");
-          else if (why == "NOT_FINITE")
+          else if (d == VertexDefect::NotFinite)
             defects_.add("NOT_FINITE", "vertex " + std::to_string(i) +
                                            " is not three finite numbers; its surface is dropped");
           else
@@ -166,22 +202,24 @@ class GeometryWalker {
                                                         std::to_string(max_abs_) + "; its surface is dropped");
           return;
         }
-        pts.push_back(p);
+        face.point(p);
       }
-      if (pts.size() < 3) {
+      const std::size_t n = face.ring_mark() - mark;
+      if (n < 3) {
         defects_.add("TOO_FEW_POINTS", std::string("a ") + (ring_no == 0 ? "surface's outer ring" : "hole") + " has " +
-                                           std::to_string(pts.size()) + " vertices (< 3); it is dropped");
+                                           std::to_string(n) + " vertices (< 3); it is dropped");
         if (ring_no == 0) return;
+        face.drop_ring(mark);
       } else {
-        rings_.push_back(std::move(pts));
+        face.end_ring();
       }
       ++ring_no;
     }
-    if (rings_.empty()) {
+    if (face.rings() == 0) {
       defects_.add("TOO_FEW_POINTS", "a surface has no ring; it is dropped");
       return;
     }
-    mesh_.add_face(rings_, kind, lod_);
+    face.end_face(kind, lod_);
   }
 
   const VertexSource& src_;
@@ -190,7 +228,6 @@ class GeometryWalker {
   double max_abs_;
   Mesh& mesh_;
   Defects& defects_;
-  std::vector<std::vector<Point3>> rings_;
 };
 
 std::vector<SurfaceKind> semantic_kinds(dom::element geometry, std::optional<dom::element>& values) {
@@ -372,7 +409,8 @@ void ObjectConverter::convert(std::string_view id_view, dom::element object, con
   int best = -1;
   std::string available;
   for (const Candidate& c : candidates) {
-    const std::string name = std::to_string(c.major) + (c.minor ? "." + std::to_string(c.minor) : "");
+    std::string name = std::to_string(c.major);
+    if (c.minor) name += '.' + std::to_string(c.minor);  // not "." + ...: GCC 12's -Wrestrict false positive
     if (available.find(name) == std::string::npos) available += (available.empty() ? "" : ", ") + name;
     if (opt_.lod >= 0 && (c.major != opt_.lod || (opt_.lod_refinement >= 0 && c.minor != opt_.lod_refinement))) continue;
     best = std::max(best, c.rank());

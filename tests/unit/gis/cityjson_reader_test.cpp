@@ -203,6 +203,7 @@ TEST(CityJsonReader, HostileObjectsAreProblemsAndTheRestIsRead) {
                            std::string(kCubeShell) + "]}]}";
   const std::string objects = "{" + good + R"(,
     "idx":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,99999999]],[[0,1,2]]]}]},
+    "hole":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,2,3],[4,5]]]}]},
     "neg":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,-2]]]}]},
     "huge":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,8]]]}]},
     "shape":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":"not an array"}]},
@@ -213,13 +214,22 @@ TEST(CityJsonReader, HostileObjectsAreProblemsAndTheRestIsRead) {
     "notype":{"geometry":[]}})";
   MemFile f("bad.city.json", cube_file(objects, "[1e999,0,0]"));
   const Read r = read(f.path);
-  ASSERT_EQ(r.meshes.size(), 2u);  // "ok", and "idx" keeps its good surface
+  ASSERT_EQ(r.meshes.size(), 3u);  // "ok", "idx" keeps its good surface, "hole" its outer ring
   EXPECT_TRUE(r.mesh("ok"));
   ASSERT_TRUE(r.mesh("idx"));
   EXPECT_EQ(r.mesh("idx")->faces.size(), 1u);
+  // Nothing of a dropped surface or ring stays in the mesh (the reader writes rings straight into it).
+  EXPECT_EQ(r.mesh("idx")->vertices.size(), 3u);
+  EXPECT_EQ(r.mesh("idx")->ring_offsets.size(), 2u);
+  ASSERT_TRUE(r.mesh("hole"));
+  ASSERT_EQ(r.mesh("hole")->faces.size(), 1u);
+  EXPECT_EQ(r.mesh("hole")->faces[0].ring_count, 1u);
+  EXPECT_EQ(r.mesh("hole")->vertices.size(), 4u);
+  EXPECT_EQ(r.mesh("hole")->indices.size(), 4u);
   std::map<std::string, std::string> code_of;
   for (const Problem& p : r.problems) code_of[p.source_id] += p.code + " ";
   EXPECT_EQ(code_of["idx"], "BAD_VERTEX_INDEX ");
+  EXPECT_EQ(code_of["hole"], "TOO_FEW_POINTS ");
   EXPECT_EQ(code_of["neg"], "BAD_VERTEX_INDEX NO_GEOMETRY ");
   EXPECT_EQ(code_of["huge"], "NOT_FINITE NO_GEOMETRY ");
   EXPECT_EQ(code_of["shape"], "BAD_GEOMETRY NO_GEOMETRY ");
