@@ -77,13 +77,21 @@ std::string cube_file(const std::string& objects, const std::string& extra_verti
 
 TEST(CityJsonReader, SolidWithTransformSemanticsAndParts) {
   const std::string objects = std::string(R"({"B1":{"type":"Building","children":["B1-0"]},)") +
-                              R"("B1-0":{"type":"BuildingPart","parents":["B1"],"geometry":[{"type":"Solid","lod":"2.2",)" +
-                              R"("boundaries":[)" + kCubeShell + R"(],"semantics":)" + kCubeSemantics + "}]}}";
+                              R"("B1-0":{"type":"BuildingPart","parents":["B1"],"attributes":{"measuredHeight":12.5},)" +
+                              R"("geometry":[{"type":"Solid","lod":"2.2",)" +
+                              R"("boundaries":[)" + kCubeShell + R"(],"semantics":)" + kCubeSemantics + "}]}," +
+                              // read after the part: nothing of the part's (parent, height) carries over
+                              R"("B2":{"type":"Building","geometry":[{"type":"Solid","lod":"2.2","boundaries":[)" +
+                              kCubeShell + "]}]}}";
   MemFile f("solid.city.json", cube_file(objects));
   const Read r = read(f.path);
   EXPECT_EQ(r.info.format, gis::InputFormat::CityJson);
-  ASSERT_EQ(r.meshes.size(), 1u);  // the Building has no geometry of its own: its part carries it
+  ASSERT_EQ(r.meshes.size(), 2u);  // B1 has no geometry of its own: its part carries it; and B2
   const Mesh& m = r.meshes[0];
+  EXPECT_EQ(m.measured_height, 12.5);
+  ASSERT_EQ(r.meshes[1].source_id, "B2");
+  EXPECT_EQ(r.meshes[1].parent_id, "");
+  EXPECT_LT(r.meshes[1].measured_height, 0);
   EXPECT_EQ(m.source_id, "B1-0");
   EXPECT_EQ(m.parent_id, "B1");
   EXPECT_EQ(m.faces.size(), 6u);
