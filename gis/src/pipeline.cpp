@@ -63,8 +63,8 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, s
           found.push_back(e.path().string());
       std::sort(found.begin(), found.end());
       if (found.empty())
-        throw InputError(in + ": folder holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb, "
-                              "*.city.json, *.city.jsonl, *.shp, *.gpkg, *.fgb, *.geojson)");
+        throw InputError(in + ": folder holds no input file (" + input_name_patterns() +
+                         ", *.shp, *.gpkg, *.fgb, *.geojson)");
       files.insert(files.end(), found.begin(), found.end());
     } else if (lower(fs::path(in).extension().string()) == ".zip") {
       // A zip of tiles: its input entries, sorted (read through GDAL's /vsizip/, side by side like a folder).
@@ -89,8 +89,7 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, s
         continue;
       }
       if (found.empty())
-        throw InputError(in + ": the zip holds no input file (*.gml, *.citygml, *.xml, *.kml, *.kmz, *.gltf, *.glb), or "
-                              "is not a zip");
+        throw InputError(in + ": the zip holds no input file (" + input_name_patterns() + "), or is not a zip");
       files.insert(files.end(), found.begin(), found.end());
     } else if (fs::exists(in, ec) || in.rfind("/vsi", 0) == 0 || looks_like_connection_string(in)) {
       files.push_back(in);

@@ -84,13 +84,31 @@ const char* to_string(InputFormat f) {
   return "?";
 }
 
+namespace {
+// The names a folder or a zip of tiles is expanded to: one list for the checks and for the messages that
+// name them. Gzip: the text formats, with ".gz" after them.
+constexpr std::string_view kInputSuffixes[] = {".gml", ".citygml", ".xml", ".kml", ".kmz", ".gltf", ".glb",
+                                               ".city.json", ".city.jsonl"};
+constexpr std::string_view kGzipSuffixes[] = {".gml", ".citygml", ".xml", ".kml", ".city.json", ".city.jsonl"};
+
+template <std::size_t N>
+bool has_suffix(const std::string& lowered, const std::string_view (&suffixes)[N]) {
+  for (std::string_view s : suffixes)
+    if (ends_with(lowered, s)) return true;
+  return false;
+}
+}  // namespace
+
+std::string input_name_patterns() {
+  std::string out;
+  for (std::string_view s : kInputSuffixes) out += (out.empty() ? "*" : ", *") + std::string(s);
+  for (std::string_view s : kGzipSuffixes) out += ", *" + std::string(s) + ".gz";
+  return out;
+}
+
 bool is_gzip_input_name(const std::string& name) {
   const std::string l = lower(name);
-  if (!ends_with(l, ".gz")) return false;
-  const std::string inner = l.substr(0, l.size() - 3);
-  const std::string ext = extension(inner);
-  return ext == ".gml" || ext == ".citygml" || ext == ".xml" || ext == ".kml" || ends_with(inner, ".city.json") ||
-         ends_with(inner, ".city.jsonl");
+  return ends_with(l, ".gz") && has_suffix(l.substr(0, l.size() - 3), kGzipSuffixes);
 }
 
 std::string open_path(const std::string& path) {
@@ -126,10 +144,7 @@ InputFormat detect_format(const std::string& path) {
 }
 
 bool is_input_name(const std::string& name) {
-  if (is_gzip_input_name(name)) return true;
-  const std::string ext = extension(name);
-  return ext == ".gml" || ext == ".citygml" || ext == ".xml" || ext == ".kml" || ext == ".kmz" || ext == ".gltf" ||
-         ext == ".glb" || ends_with(lower(name), ".city.json") || ends_with(lower(name), ".city.jsonl");
+  return is_gzip_input_name(name) || has_suffix(lower(name), kInputSuffixes);
 }
 
 void read_any(const std::string& path, const ReadOptions& options, const MeshCallback& on_mesh,

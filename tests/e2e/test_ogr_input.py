@@ -409,6 +409,7 @@ def test_a_folder_of_shapefiles_and_geopackages_is_one_input(tmp_path, city_foot
         p.unlink()
     r = run([BIN, "-f", "GPKG", tmp_path / "x.gpkg", folder], check=False)
     assert r.returncode == 1 and "folder holds no input file" in r.stderr and "*.shp" in r.stderr
+    assert "*.city.json.gz" in r.stderr  # every name a folder is expanded to, compressed ones too
 
 
 def _two_geometry_sqlite(path):

@@ -46,6 +46,14 @@ TEST(CompressedInput, NamesAndFormats) {
     EXPECT_TRUE(gis::is_input_name(name)) << name;
   }
   for (const char* name : {"a.gz", "a.tar.gz", "a.json.gz", "a.gml"}) EXPECT_FALSE(gis::is_gzip_input_name(name)) << name;
+  // The messages that say what a folder or zip may hold name exactly what is taken.
+  const std::string patterns = gis::input_name_patterns();
+  for (const std::string name : {"x.gml", "x.citygml", "x.xml", "x.kml", "x.kmz", "x.gltf", "x.glb", "x.city.json",
+                                 "x.city.jsonl", "x.gml.gz", "x.kml.gz", "x.city.json.gz", "x.city.jsonl.gz"}) {
+    EXPECT_TRUE(gis::is_input_name(name)) << name;
+    EXPECT_NE(patterns.find("*" + name.substr(1)), std::string::npos) << name << " not in " << patterns;
+  }
+  for (const char* name : {"x.dae", "tileset.json", "x.kmz.gz", "x.txt"}) EXPECT_FALSE(gis::is_input_name(name)) << name;
   EXPECT_EQ(gis::detect_format("x.city.json.gz", ""), gis::InputFormat::CityJson);
   EXPECT_EQ(gis::detect_format("x.city.jsonl.gz", ""), gis::InputFormat::CityJsonSeq);
   EXPECT_EQ(gis::detect_format("x.gml.gz", ""), gis::InputFormat::CityGml);

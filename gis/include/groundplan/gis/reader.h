@@ -77,6 +77,8 @@ InputFormat detect_format(const std::string& name, std::string_view head);
 /// .city.json .city.jsonl; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
 /// plain .json: a tile folder holds other JSON, e.g. 3D Tiles' tileset.json).
 bool is_input_name(const std::string& name);
+/// The names is_input_name takes, for messages: "*.gml, *.citygml, ..., *.city.jsonl.gz".
+std::string input_name_patterns();
 /// A gzip-compressed input by its name (issue 16): `x.gml.gz`, `x.citygml.gz`, `x.xml.gz`, `x.city.json.gz`,
 /// `x.city.jsonl.gz`, `x.kml.gz` (any case). Such a file is read through GDAL's /vsigzip/.
 bool is_gzip_input_name(const std::string& name);
