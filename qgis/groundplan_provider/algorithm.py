@@ -96,12 +96,12 @@ class GroundPlansAlgorithm(QgsProcessingAlgorithm):
                                                  "ground surfaces only", "decompose the surfaces"],
             defaultValue=0))
         self.addParameter(QgsProcessingParameterNumber(
-            "RESOLUTION", "Raster resolution for finding blocks (m, 0 = automatic; the result is exact anyway)",
+            "RESOLUTION", "Raster resolution (m, 0 = automatic; the result is exact)",
             type=QgsProcessingParameterNumber.Double, defaultValue=0.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterEnum("PRESET", "Level-of-detail preset", options=PRESETS,
                                                      defaultValue=0))
-        self.addParameter(QgsProcessingParameterCrs("T_SRS", "Target CRS (projected, metric; default: the "
-                                                    "source CRS when projected, else its UTM zone)", optional=True))
+        self.addParameter(QgsProcessingParameterCrs("T_SRS", "Target CRS (projected; default: the source's, "
+                                                    "else its UTM zone)", optional=True))
         advanced = [
             QgsProcessingParameterString("LOD", "Level of detail to read (-1 = the highest each building has; "
                                          "CityJSON: 1.2, 2.2 ...)", defaultValue="-1"),
