@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 // The process-wide cache of pipeline results behind GROUNDPLAN: opens (result_cache.h says what and why).
 #include "result_cache.h"
+#include "result_store.h"
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
 
+#include <dlfcn.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -88,7 +90,7 @@ class ResultCache {
     lock.unlock();
     SharedResult result;
     try {
-      result = run(what, compute);
+      result = produce(key, what, compute);
     } catch (...) {
       lock.lock();
       slots_.erase(key);
@@ -113,6 +115,21 @@ class ResultCache {
   }
 
   static std::size_t runs() { return runs_.load(); }
+
+  /// From GROUNDPLAN_CACHE_DIR when it holds `key`, else computed (and stored there when it is set).
+  static SharedResult produce(const std::string& key, const std::string& what,
+                              const std::function<gis::PipelineResult()>& compute) {
+    const std::string dir = result_store_dir();
+    if (!dir.empty()) {
+      if (std::optional<gis::PipelineResult> stored = load_result(dir, key)) {
+        CPLDebug("GroundPlan", "result for %s read from %s", what.c_str(), dir.c_str());
+        return std::make_shared<const gis::PipelineResult>(std::move(*stored));
+      }
+    }
+    SharedResult result = run(what, compute);
+    if (!dir.empty()) store_result(dir, key, *result);
+    return result;
+  }
 
  private:
   struct Slot {
@@ -164,11 +181,24 @@ ResultCache& cache() {
   return *c;
 }
 
+/// The file holding this code (the plugin, the Python module or a program linking the driver statically), with
+/// its stamp: the pipeline is compiled into it, so another build is another key.
+std::string build_identity() {
+  Dl_info info{};
+  std::string id = "build\t";
+  if (dladdr(reinterpret_cast<void*>(&build_identity), &info) && info.dli_fname) {
+    id += info.dli_fname;
+    id += '\t';
+    if (!file_stamp(info.dli_fname, id)) id += "unknown";
+  }
+  return id + '\n';
+}
+
 }  // namespace
 
 std::string result_cache_key(const std::vector<std::string>& inputs, char** open_options) {
   if (!CPLTestBool(CPLGetConfigOption("GROUNDPLAN_CACHE", "YES"))) return {};
-  std::string key;
+  std::string key = build_identity();
   for (const std::string& input : inputs) {
     if (STARTS_WITH(input.c_str(), "/vsi")) return {};
     std::error_code ec;

@@ -15,10 +15,13 @@
 // GROUNDPLAN_CACHE_ENTRIES results (default 4) closed datasets left are kept while their estimated size is
 // within GROUNDPLAN_CACHE_MAX_MB (default 1024); older ones are dropped first. GROUNDPLAN_CACHE=NO turns
 // the cache off. These are GDAL configuration options (environment variables or --config).
+// GROUNDPLAN_CACHE_DIR=<folder> adds a cache across processes (result_store.h; off by default). The key also
+// names the build of the code (the plugin's file and stamp), so another build never reads this one's results.
 //
 // Thread-safe: two opens of one key at once compute once, the second waits for the first; a failure
 // reaches both and is not kept. CPL_DEBUG=ON shows "GroundPlan: pipeline run N for <connection>" for every
-// computation and "GroundPlan: cached result for <connection>" for every hit.
+// computation, "GroundPlan: cached result for <connection>" for every hit in the process and "GroundPlan:
+// result for <connection> read from <folder>" for every hit in GROUNDPLAN_CACHE_DIR.
 #include <groundplan/gis/pipeline.h>
 
 #include <cstddef>

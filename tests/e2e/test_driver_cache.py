@@ -177,3 +177,65 @@ def test_update_access_is_answered_quietly(sample):
     n = lyr.GetFeatureCount()
     assert lyr.CreateFeature(ogr.Feature(lyr.GetLayerDefn())) == ogr.OGRERR_UNSUPPORTED_OPERATION
     assert lyr.GetFeatureCount() == n
+
+
+DUMP = """
+import json
+ds = gdal.OpenEx("GROUNDPLAN:{src}", gdal.OF_VECTOR)
+out = {{}}
+for name in ("ground_plans", "footprints", "problems", "plan_members"):
+    lyr = ds.GetLayerByName(name)
+    out[name] = [[f.items(), bytes(f.GetGeometryRef().ExportToIsoWkb()).hex() if f.GetGeometryRef() else None]
+                 for f in lyr]
+out["crs"] = ds.GetLayerByName("ground_plans").GetSpatialRef().ExportToWkt()
+print(json.dumps(out))
+"""
+
+
+def test_persistent_cache_serves_the_next_process_and_is_never_stale(sample, tmp_path):
+    store = tmp_path / "store"
+    dump = DUMP.format(src=sample)
+    first, runs, _ = run_script(dump, GROUNDPLAN_CACHE_DIR=str(store))
+    assert len(runs) == 1
+    files = list(store.glob("*.gpresult"))
+    assert len(files) == 1 and not list(store.glob("*.tmp*"))  # written whole, under its final name
+
+    p = subprocess.run([sys.executable, "-c", PRELUDE + dump], capture_output=True, text=True, timeout=600,
+                       env=dict(gdal_env(), CPL_DEBUG="ON", GROUNDPLAN_CACHE_DIR=str(store)))
+    assert p.returncode == 0, p.stderr
+    assert "GroundPlan: pipeline run" not in p.stderr and "read from" in p.stderr
+    assert p.stdout == first  # every layer, field and coordinate the same as computed
+
+    # Off by default: without the option the next process computes.
+    _, runs, _ = run_script(dump)
+    assert len(runs) == 1
+
+    # The input changes (same size, new time): computed again, not read.
+    st = os.stat(sample)
+    os.utime(sample, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+    _, runs, _ = run_script(dump, GROUNDPLAN_CACHE_DIR=str(store))
+    assert len(runs) == 1
+    assert len(list(store.glob("*.gpresult"))) == 2
+
+
+def test_persistent_cache_ignores_files_of_another_key_or_damaged(sample, tmp_path):
+    store = tmp_path / "store"
+    dump = DUMP.format(src=sample)
+    truth, runs, _ = run_script(dump, GROUNDPLAN_CACHE_DIR=str(store))
+    [stored] = store.glob("*.gpresult")
+    good = stored.read_bytes()
+
+    # Another input's result under this key's file name (what a hash collision would give): not used.
+    other = tmp_path / "other"
+    other.mkdir()
+    shutil.copy(PLATEAU_SMALL, other / "b.gml")
+    other_store = tmp_path / "other_store"
+    run_script(DUMP.format(src=other / "b.gml"), GROUNDPLAN_CACHE_DIR=str(other_store),
+               GROUNDPLAN_CACHE_ENTRIES="0")
+    [foreign] = other_store.glob("*.gpresult")
+    for damaged in (foreign.read_bytes(), good[: len(good) // 2], good[:-1] + bytes([good[-1] ^ 1]) + b"x"):
+        stored.write_bytes(damaged)
+        out, runs, _ = run_script(dump, GROUNDPLAN_CACHE_DIR=str(store))
+        assert len(runs) == 1, "a foreign or damaged file was used"
+        assert out == truth
+        stored.write_bytes(good)
