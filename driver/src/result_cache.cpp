@@ -75,6 +75,7 @@ class ResultCache {
     if (found != slots_.end()) {
       if (SharedResult live = found->second.live.lock()) {
         touch(key, live);
+        lock.unlock();  // no call out (an error handler may be Python, waiting for its GIL) under the lock
         CPLDebug("GroundPlan", "cached result for %s", what.c_str());
         return live;
       }

@@ -251,3 +251,37 @@ def test_algorithm_reports_progress_and_stops_when_cancelled(qgis_env, sample, t
     assert any(0 < x < 80 for x in v)  # the pipeline's own progress, not only the writing
     assert cancelled["outputs"] == []
     assert max(cancelled["values"]) < 80  # stopped inside the pipeline
+
+
+def test_algorithm_folder_preset_and_crs_match_the_driver(qgis_env, tmp_path):
+    """FOLDER, PRESET and T_SRS reach the pipeline as the driver's FOLDER input, PRESET= and T_SRS= do."""
+    folder = tmp_path / "tiles"
+    folder.mkdir()
+    shutil.copy(PLATEAU_SMALL, folder / "a.gml")
+    shutil.copy(PLATEAU, folder / "b.gml")
+    got, _, _ = run_qgis(qgis_env, f"""
+        sys.path.insert(0, "{PLUGIN_PARENT}")
+        from qgis.core import (QgsProcessingContext, QgsProcessingFeedback, QgsVectorLayer,
+                               QgsCoordinateReferenceSystem)
+        from groundplan_provider.algorithm import GroundPlansAlgorithm
+        alg = GroundPlansAlgorithm()
+        alg.initAlgorithm()
+        res, ok = alg.run({{"FOLDER": "{folder}", "PRESET": 1, "T_SRS": QgsCoordinateReferenceSystem("EPSG:6677"),
+                           "OUTPUT": "{tmp_path}/alg.gpkg", "FOOTPRINTS_OUTPUT": None, "PROBLEMS_OUTPUT": None}},
+                          QgsProcessingContext(), QgsProcessingFeedback())
+        assert ok, res
+        print(json.dumps(res))
+    """)
+    ours, ours_epsg = rows_of(got["OUTPUT"].split("|")[0], pathlib.Path(got["OUTPUT"].split("layername=")[-1]).name
+                              if "layername=" in got["OUTPUT"] else "alg")
+    ds = gdal.OpenEx(f"GROUNDPLAN:{folder}", gdal.OF_VECTOR, open_options=["PRESET=CFD", "T_SRS=EPSG:6677"])
+    lyr = ds.GetLayerByName("ground_plans")
+    theirs = [(f.items(), bytes(f.GetGeometryRef().ExportToIsoWkb()).hex()) for f in lyr]
+    assert ours_epsg == "6677"
+    assert len(ours) == len(theirs) > 0
+    exact_ds = gdal.OpenEx(f"GROUNDPLAN:{folder}", gdal.OF_VECTOR)  # kept: a layer dies with its dataset
+    exact = exact_ds.GetLayerByName("ground_plans").GetFeatureCount()
+    assert exact != len(theirs)  # the preset changed the result, so passing it is tested
+    for (a, ga), (b, gb) in zip(ours, theirs):
+        assert a == b
+        assert ogr.CreateGeometryFromWkb(bytes.fromhex(ga)).Equals(ogr.CreateGeometryFromWkb(bytes.fromhex(gb)))
