@@ -35,6 +35,15 @@ install(TARGETS libgroundplan EXPORT groundplanTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT runtime)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/core/include/groundplan ${CMAKE_SOURCE_DIR}/gis/include/groundplan
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT runtime FILES_MATCHING PATTERN "*.h")
+# The QGIS plugin (issue 18, qgis/groundplan_provider): Debian's QGIS looks for Python plugins in its own
+# pkgDataPath()/python/plugins, /usr/share/qgis/python/plugins (beside its processing and db_manager), and in
+# the user's profile; the first is the one a package may write. QGIS lists it under Plugins > Manage and
+# Install Plugins; enabling it there (or `qgis_process plugins enable groundplan_provider`) adds the
+# algorithm to the Processing toolbox.
+set(GROUNDPLAN_QGIS_PLUGIN_INSTALL_DIR "share/qgis/python/plugins" CACHE STRING
+    "Where the QGIS Processing plugin is installed, relative to CMAKE_INSTALL_PREFIX (QGIS's plugin folder)")
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/qgis/groundplan_provider DESTINATION ${GROUNDPLAN_QGIS_PLUGIN_INSTALL_DIR}
+        COMPONENT runtime FILES_MATCHING PATTERN "*.py" PATTERN "metadata.txt" PATTERN "__pycache__" EXCLUDE)
 install(FILES ${CMAKE_SOURCE_DIR}/packaging/groundplan.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime)
 install(FILES ${CMAKE_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
 

@@ -26,6 +26,9 @@ packages=(
   # the Python module (issue 23, python/): pybind11 and the headers to build it; Shapely, GeoPandas (Fiona,
   # pyproj) for its wrapper and tests. Debian bookworm has no pyogrio: its test skips.
   python3-dev pybind11-dev python3-shapely python3-fiona python3-pyproj python3-numpy
+  # QGIS as a client (issue 18, qgis/ and tests/e2e/test_qgis*.py): PyQGIS and the OGR provider to load and
+  # render the driver's layers, qgis for qgis_process (runs the Processing algorithm), xvfb for headless runs
+  python3-qgis qgis-providers qgis xvfb
   # fuzzing (libFuzzer with clang; tests/fuzz) and the sanitizer runtime's symbolizer
   clang libclang-rt-14-dev llvm
 )

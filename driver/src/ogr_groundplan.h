@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 // OGR side of groundplan: a read-only dataset whose layers are the pipeline's result
-// (ground_plans, footprints, problems). The pipeline runs once, when the dataset is opened.
+// (ground_plans, footprints, problems, plan_members). The result is computed when the first dataset of an
+// input is opened and shared by later opens (result_cache.h).
 #include <groundplan/gis/pipeline.h>
 
 #include <gdal_priv.h>

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The dataset behind GROUNDPLAN:<path>: runs the pipeline once on open and serves three layers.
+// The dataset behind GROUNDPLAN:<path>: takes the pipeline's result on open (computed once per input and
+// options in a process: result_cache.h) and serves its layers.
 #include "ogr_groundplan.h"
 #include "open_options.h"
+#include "result_cache.h"
 
 #include <groundplan/error.h>
 
@@ -224,14 +226,14 @@ int OGRGroundPlanDataSource::Identify(GDALOpenInfo* info) {
 
 GDALDataset* OGRGroundPlanDataSource::Open(GDALOpenInfo* info) {
   if (!Identify(info)) return nullptr;
-  if (info->eAccess == GA_Update) {
-    CPLError(CE_Failure, CPLE_NotSupported, "GroundPlan: the driver is read-only");
-    return nullptr;
-  }
+  // Update access (QGIS probes it on every layer load) gets the same read-only dataset, quietly: its
+  // layers answer no to every write capability and refuse writes, as read-only layers of other drivers do.
+  if (info->eAccess == GA_Update) CPLDebug("GroundPlan", "update access asked: the layers stay read-only");
   // Entry point: convert exceptions once, here (STYLE.md §4).
   try {
     const gis::PipelineOptions options = pipeline_options_from(info->pszFilename, info->papszOpenOptions);
-    auto result = std::make_shared<const gis::PipelineResult>(gis::run_pipeline(options));
+    SharedResult result = cached_pipeline_result(result_cache_key(options.inputs, info->papszOpenOptions),
+                                                 info->pszFilename, [&] { return gis::run_pipeline(options); });
     return new OGRGroundPlanDataSource(info->pszFilename, std::move(result), 0, options.threads);
   } catch (const std::exception& e) {
     CPLError(CE_Failure, CPLE_AppDefined, "GroundPlan: %s", e.what());

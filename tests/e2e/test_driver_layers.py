@@ -86,6 +86,11 @@ def test_members_table_matches_the_id_lists(ds):
     assert members == plans
 
 
-def test_update_mode_is_refused():
-    with pytest.raises(RuntimeError, match="read-only"):
-        gdal.OpenEx(f"GROUNDPLAN:{BERLIN}", gdal.OF_VECTOR | gdal.OF_UPDATE)
+def test_update_mode_gives_read_only_layers():
+    # Issue 18: update access (QGIS probes it on every load) opens without an error, and nothing can be
+    # written: the dataset makes no layer, its layers take no feature (test_driver_cache.py checks those).
+    ds = gdal.OpenEx(f"GROUNDPLAN:{BERLIN}", gdal.OF_VECTOR | gdal.OF_UPDATE)
+    assert not ds.TestCapability(ogr.ODsCCreateLayer) and not ds.TestCapability(ogr.ODsCDeleteLayer)
+    with pytest.raises(RuntimeError, match="not supported"):
+        ds.CreateLayer("x", geom_type=ogr.wkbPolygon)
+    assert ds.GetLayerCount() == 4

@@ -83,3 +83,13 @@ int main() {
     p = subprocess.run([str(exe)], capture_output=True, text=True, env=dict(os.environ, LD_LIBRARY_PATH=str(libdir)))
     assert p.returncode == 0, p.stderr
     assert p.stdout.split() == ["1", "7.000000"]
+
+
+def test_packaged_qgis_plugin_is_in_qgis_plugin_folder(root):
+    """Debian's QGIS finds system-wide Python plugins in /usr/share/qgis/python/plugins (its pkgDataPath)."""
+    plugin = root / "usr" / "share" / "qgis" / "python" / "plugins" / "groundplan_provider"
+    for name in ("__init__.py", "metadata.txt", "plugin.py", "provider.py", "algorithm.py"):
+        assert (plugin / name).is_file(), name
+    assert "hasProcessingProvider=yes" in (plugin / "metadata.txt").read_text()
+    python_dir = root / "usr" / "lib" / "python3" / "dist-packages" / "groundplan"
+    assert (python_dir / "__init__.py").is_file(), "the plugin drives the Python module: it must be packaged too"
