@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "citygml/coordinates.h"
 
+#include "citygml/decimal.h"
+
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -13,7 +15,7 @@ inline bool is_space(char c) { return c == ' ' || c == '\n' || c == '\t' || c ==
 inline CoordStatus parse_one(const char*& p, const char* end, std::vector<double>& out) {
   if (*p == '+') ++p;  // from_chars refuses a leading '+'; xs:double allows it
   double v;
-  auto [next, ec] = std::from_chars(p, end, v);
+  auto [next, ec] = parse_decimal(p, end, v);
   if (ec != std::errc() || (next != end && !is_space(*next))) {
     if (ec == std::errc::result_out_of_range) return CoordStatus::NotFinite;
     return CoordStatus::BadNumber;

@@ -1,0 +1,16 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// Decimal numbers as gml:posList writes them (issue 14: the reader's speed per core). The common case,
+// at most 19 significant digits and a value exactly m x 10^e with m < 2^53 and |e| <= 22, is one IEEE
+// multiplication or division of two exact doubles, so correctly rounded (Clinger's fast path, as in
+// strtod and fast_float); everything else goes to std::from_chars, which rounds correctly too.
+#include <charconv>
+#include <cstdint>
+
+namespace groundplan::gis::detail {
+
+/// Parses a number at [p, end) as std::from_chars(p, end, v) does (no leading '+', no hex, "inf"/"nan"
+/// accepted) and gives the same result: ptr past the number, ec as from_chars sets it.
+std::from_chars_result parse_decimal(const char* p, const char* end, double& v);
+
+}  // namespace groundplan::gis::detail
