@@ -12,7 +12,12 @@ inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; 
 
 }  // namespace
 
-std::from_chars_result parse_decimal(const char* p, const char* end, double& v) {
+std::from_chars_result parse_decimal(const char* p, const char* end, double& v, bool* slow) {
+  // From here on, every way out but the last is from_chars deciding.
+  auto fallback = [&] {
+    if (slow) *slow = true;
+    return std::from_chars(p, end, v);
+  };
   const char* s = p;
   const bool negative = s < end && *s == '-';
   if (negative) ++s;
@@ -30,21 +35,21 @@ std::from_chars_result parse_decimal(const char* p, const char* end, double& v) 
     digits += s - frac;
   }
   // No digit ("inf", "nan", ".", "-", garbage) or too many: from_chars decides.
-  if (digits == 0 || digits > 19) return std::from_chars(p, end, v);
+  if (digits == 0 || digits > 19) return fallback();
   if (s < end && (*s == 'e' || *s == 'E')) {
     const char* e = s + 1;
     bool eneg = false;
     if (e < end && (*e == '-' || *e == '+')) eneg = *e++ == '-';
-    if (e == end || !is_digit(*e)) return std::from_chars(p, end, v);  // "1e", "1e+": from_chars decides
+    if (e == end || !is_digit(*e)) return fallback();  // "1e", "1e+": from_chars decides
     int x = 0;
     for (; e < end && is_digit(*e); ++e) {
-      if (x > 10000) return std::from_chars(p, end, v);
+      if (x > 10000) return fallback();
       x = x * 10 + (*e - '0');
     }
     exponent += eneg ? -x : x;
     s = e;
   }
-  if (m > (std::uint64_t{1} << 53) || exponent < -22 || exponent > 22) return std::from_chars(p, end, v);
+  if (m > (std::uint64_t{1} << 53) || exponent < -22 || exponent > 22) return fallback();
   double d = static_cast<double>(m);  // exact: m <= 2^53
   d = exponent < 0 ? d / kPow10[-exponent] : d * kPow10[exponent];
   v = negative ? -d : d;

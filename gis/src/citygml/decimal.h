@@ -10,7 +10,9 @@
 namespace groundplan::gis::detail {
 
 /// Parses a number at [p, end) as std::from_chars(p, end, v) does (no leading '+', no hex, "inf"/"nan"
-/// accepted) and gives the same result: ptr past the number, ec as from_chars sets it.
-std::from_chars_result parse_decimal(const char* p, const char* end, double& v);
+/// accepted) and gives the same result: ptr past the number, ec as from_chars sets it. `slow`, when
+/// given, is set when the number needed from_chars (a 17-digit latitude does): a caller with a list of
+/// such numbers then calls from_chars itself, not paying the fast path's attempt on each.
+std::from_chars_result parse_decimal(const char* p, const char* end, double& v, bool* slow = nullptr);
 
 }  // namespace groundplan::gis::detail

@@ -4,6 +4,7 @@
 // std::from_chars on where a number ends and on what is refused.
 #include <gtest/gtest.h>
 
+#include "citygml/coordinates.h"
 #include "citygml/decimal.h"
 
 #include <charconv>
@@ -72,10 +73,16 @@ TEST(Decimal, RandomAgainstStrtod) {
     const int shape = static_cast<int>(rng() % 4);
     if (shape == 0) {  // posList-like: 1-7 integer digits, 0-4 decimals
       s += digits(rng, 1 + static_cast<int>(rng() % 7), true);
-      if (rng() % 4) s += "." + digits(rng, static_cast<int>(rng() % 5), false);
+      if (rng() % 4) {
+        s += '.';
+        s += digits(rng, static_cast<int>(rng() % 5), false);
+      }
     } else {  // any length of mantissa, up to 25 + 25 digits, leading zeros possible
       s += digits(rng, static_cast<int>(rng() % 26), false);
-      if (rng() % 2) s += "." + digits(rng, static_cast<int>(rng() % 26), false);
+      if (rng() % 2) {
+        s += '.';
+        s += digits(rng, static_cast<int>(rng() % 26), false);
+      }
       if (s.empty() || s == "-" || s.back() == '.' || s == "-.") s += digits(rng, 1, false);
     }
     if (shape >= 2) {  // an exponent, near (fast path) or far (fallback)
@@ -99,6 +106,28 @@ TEST(Decimal, ExactFastPathValues) {
     const std::string s = std::to_string(m) + "e" + std::to_string(e);
     expect_same(s);
     if (HasFailure()) return;
+  }
+}
+
+TEST(Decimal, ListsMixingShortAndLongNumbersParseAsStrtodDoes) {
+  // parse_numbers leaves the fast path for the rest of a list once a number needs from_chars
+  // (17 significant digits, as in some PLATEAU longitudes): every number still comes out as strtod reads it.
+  std::mt19937_64 rng(6697);
+  for (int i = 0; i < 2000; ++i) {
+    std::string list;
+    std::vector<double> want;
+    const int n = 1 + static_cast<int>(rng() % 12);
+    for (int k = 0; k < n; ++k) {
+      std::string num = (rng() % 3 == 0) ? "139." + digits(rng, 14, false) : digits(rng, 1 + static_cast<int>(rng() % 6), true) + "." + digits(rng, 3, false);
+      if (rng() % 4 == 0) num = "-" + num;
+      want.push_back(std::strtod(num.c_str(), nullptr));
+      list += num;
+      list += (rng() % 2) ? " " : "\n\t";
+    }
+    std::vector<double> got;
+    ASSERT_EQ(parse_numbers(list, got), CoordStatus::Ok) << list;
+    ASSERT_EQ(got.size(), want.size()) << list;
+    for (std::size_t k = 0; k < got.size(); ++k) ASSERT_EQ(bits(got[k]), bits(want[k])) << list << " #" << k;
   }
 }
 
