@@ -15,6 +15,7 @@
 #include <groundplan/gis/citygml_chunks.h>
 
 #include "citygml/coordinates.h"
+#include "citygml/element_names.h"
 #include "citygml/file_problems.h"
 
 #include <cpl_vsi.h>
@@ -39,167 +40,12 @@ constexpr char kSep = ' ';  // namespace URI / local name separator: URIs cannot
 constexpr int kChunk = 1 << 20;
 constexpr std::uint8_t kNoLod = 255;
 
-enum class Ns : std::uint8_t { None, Gml, CityGml, Xlink, Other };
-
-enum class Tag : std::uint8_t {
-  None,
-  // CityGML (any module, any version)
-  CityModel, Building, BuildingPart, Ground, Roof, Wall, Closure, OtherSurface, Excluded, Skip, MeasuredHeight,
-  LodSurface, LodSkip,
-  // GML
-  Polygon, LinearRing, Exterior, Interior, PosList, Pos, Coordinates, OrientableSurface, Envelope, LowerCorner,
-  UpperCorner, Name, CurveRing,
-};
-
-const std::unordered_map<std::string_view, Tag>& citygml_tags() {
-  static const std::unordered_map<std::string_view, Tag> m = {
-      {"CityModel", Tag::CityModel},
-      {"Building", Tag::Building},
-      {"BuildingPart", Tag::BuildingPart},
-      {"GroundSurface", Tag::Ground},
-      {"RoofSurface", Tag::Roof},
-      {"WallSurface", Tag::Wall},
-      {"ClosureSurface", Tag::Closure},
-      {"OuterCeilingSurface", Tag::OtherSurface},
-      {"OuterFloorSurface", Tag::OtherSurface},
-      {"Window", Tag::OtherSurface},
-      {"Door", Tag::OtherSurface},
-      {"DoorSurface", Tag::OtherSurface},
-      {"WindowSurface", Tag::OtherSurface},
-      // Inside a building but not part of its shell: parsed into the side mesh (xlink targets only).
-      {"BuildingInstallation", Tag::Excluded},
-      {"IntBuildingInstallation", Tag::Excluded},
-      {"Room", Tag::Excluded},
-      {"BuildingFurniture", Tag::Excluded},
-      {"BuildingRoom", Tag::Excluded},
-      {"Storey", Tag::Excluded},
-      {"BuildingUnit", Tag::Excluded},
-      {"BuildingConstructiveElement", Tag::Excluded},
-      {"interiorRoom", Tag::Excluded},
-      {"interiorFurniture", Tag::Excluded},
-      {"outerBuildingInstallation", Tag::Excluded},
-      {"interiorBuildingInstallation", Tag::Excluded},
-      {"buildingInstallation", Tag::Excluded},
-      {"buildingRoom", Tag::Excluded},
-      {"buildingFurniture", Tag::Excluded},
-      {"buildingSubdivision", Tag::Excluded},
-      {"buildingConstructiveElement", Tag::Excluded},
-      // Never geometry of the building's shell, never an xlink target we need.
-      {"appearance", Tag::Skip},
-      {"address", Tag::Skip},
-      {"externalReference", Tag::Skip},
-      {"measuredHeight", Tag::MeasuredHeight},
-  };
-  return m;
-}
-
-const std::unordered_map<std::string_view, Tag>& gml_tags() {
-  static const std::unordered_map<std::string_view, Tag> m = {
-      {"Polygon", Tag::Polygon},
-      {"PolygonPatch", Tag::Polygon},
-      {"Triangle", Tag::Polygon},
-      {"Rectangle", Tag::Polygon},
-      {"LinearRing", Tag::LinearRing},
-      {"exterior", Tag::Exterior},
-      {"outerBoundaryIs", Tag::Exterior},
-      {"interior", Tag::Interior},
-      {"innerBoundaryIs", Tag::Interior},
-      {"posList", Tag::PosList},
-      {"pos", Tag::Pos},
-      {"coordinates", Tag::Coordinates},
-      {"OrientableSurface", Tag::OrientableSurface},
-      {"Envelope", Tag::Envelope},
-      {"lowerCorner", Tag::LowerCorner},
-      {"upperCorner", Tag::UpperCorner},
-      {"name", Tag::Name},
-      {"Ring", Tag::CurveRing},
-  };
-  return m;
-}
-
-Ns classify_ns(std::string_view uri) {
-  if (uri.empty()) return Ns::None;
-  if (uri == "http://www.opengis.net/gml" || uri == "http://www.opengis.net/gml/3.2") return Ns::Gml;
-  if (uri.starts_with("http://www.opengis.net/citygml/")) return Ns::CityGml;
-  if (uri == "http://www.w3.org/1999/xlink") return Ns::Xlink;
-  return Ns::Other;
-}
-
-// Attribute names in namespace mode: "srsName" (no namespace) or "URI local".
-struct Attrs {
-  const char* gml_id = nullptr;
-  const char* href = nullptr;
-  const char* srs_name = nullptr;
-  const char* srs_dimension = nullptr;
-  const char* orientation = nullptr;
-  const char* cs = nullptr;
-  const char* ts = nullptr;
-  const char* decimal = nullptr;
-};
-
-Attrs scan_attrs(const char** atts) {
-  Attrs a;
-  for (; *atts; atts += 2) {
-    const char* n = atts[0];
-    const char* sp = std::strrchr(n, kSep);
-    if (!sp) {
-      switch (n[0]) {
-        case 's':
-          if (!std::strcmp(n, "srsName")) a.srs_name = atts[1];
-          else if (!std::strcmp(n, "srsDimension")) a.srs_dimension = atts[1];
-          break;
-        case 'o':
-          if (!std::strcmp(n, "orientation")) a.orientation = atts[1];
-          break;
-        case 'c':
-          if (!std::strcmp(n, "cs")) a.cs = atts[1];
-          break;
-        case 't':
-          if (!std::strcmp(n, "ts")) a.ts = atts[1];
-          break;
-        case 'd':
-          if (!std::strcmp(n, "decimal")) a.decimal = atts[1];
-          break;
-        default:
-          break;
-      }
-    } else {
-      std::string_view local(sp + 1);
-      std::string_view uri(n, static_cast<std::size_t>(sp - n));
-      if (local == "id" && classify_ns(uri) == Ns::Gml) a.gml_id = atts[1];
-      else if (local == "href" && uri == "http://www.w3.org/1999/xlink") a.href = atts[1];
-    }
-  }
-  return a;
-}
-
-/// srsDimension "2" or "3" (spaces around allowed) -> 2 or 3; anything else (a claim of 1e9 dimensions,
-/// a negative or a non-number) -> 0.
-int srs_dimension_value(std::string_view v) {
-  while (!v.empty() && (v.front() == ' ' || v.front() == '\t' || v.front() == '\n' || v.front() == '\r')) v.remove_prefix(1);
-  while (!v.empty() && (v.back() == ' ' || v.back() == '\t' || v.back() == '\n' || v.back() == '\r')) v.remove_suffix(1);
-  return v == "2" ? 2 : v == "3" ? 3 : 0;
-}
-
-/// "lod2Solid" -> lod 2, surface geometry; "lod2TerrainIntersection" -> skip. Returns false if not lodN*.
-bool parse_lod_property(std::string_view local, std::uint8_t& lod, Tag& tag, SurfaceKind& kind) {
-  if (local.size() < 5 || !local.starts_with("lod") || local[3] < '0' || local[3] > '4') return false;
-  lod = static_cast<std::uint8_t>(local[3] - '0');
-  std::string_view rest = local.substr(4);
-  kind = SurfaceKind::Unknown;
-  if (rest == "Solid" || rest == "MultiSurface" || rest == "Geometry" || rest == "CompositeSurface") {
-    tag = Tag::LodSurface;
-  } else if (rest == "FootPrint") {
-    tag = Tag::LodSurface;
-    kind = SurfaceKind::FootPrint;
-  } else if (rest == "RoofEdge") {
-    tag = Tag::LodSurface;
-    kind = SurfaceKind::RoofEdge;
-  } else {
-    tag = Tag::LodSkip;  // MultiCurve, TerrainIntersection, ImplicitRepresentation, Point, attributes like lod1HeightType
-  }
-  return true;
-}
+using citygml::Attrs;
+using citygml::NameSplitter;
+using citygml::Ns;
+using citygml::Tag;
+using citygml::parse_lod_property;
+using citygml::srs_dimension_value;
 
 struct IdRange {
   bool side = false;  // in the side mesh (rooms, installations ...)
@@ -467,13 +313,13 @@ class Reader {
       return;
     }
     const std::size_t depth = frames_.size() + 1;  // this element's depth once its frame is pushed
-    const char* sp = std::strrchr(name, kSep);
-    std::string_view local = sp ? std::string_view(sp + 1) : std::string_view(name);
-    Ns ns = sp ? classify_ns(std::string_view(name, static_cast<std::size_t>(sp - name))) : Ns::None;
+    const citygml::SplitName split = names_.split(name);
+    const std::string_view local = split.local;
+    const Ns ns = split.ns;
 
     Frame f = frames_.back();
     f.tag = Tag::None;
-    Attrs a = atts[0] ? scan_attrs(atts) : Attrs{};
+    Attrs a = atts[0] ? citygml::scan_attrs(atts, names_) : Attrs{};
     if (a.srs_name) note_srs(a.srs_name);
     BuildingCtx* b = building();
     if (a.srs_dimension) {
@@ -486,9 +332,8 @@ class Reader {
     }
 
     if (ns == Ns::CityGml) {
-      if (info_.citygml_version.empty()) note_version(std::string_view(name, static_cast<std::size_t>(sp - name)));
-      auto it = citygml_tags().find(local);
-      Tag t = it == citygml_tags().end() ? Tag::None : it->second;
+      if (info_.citygml_version.empty()) note_version(split.uri);
+      Tag t = citygml::citygml_tag(local);
       std::uint8_t lod;
       SurfaceKind lod_kind;
       if (t == Tag::None && parse_lod_property(local, lod, t, lod_kind)) {
@@ -524,11 +369,10 @@ class Reader {
         default:
           break;
       }
-    } else if (ns == Ns::Other && b && b->foreign_gml_ns.empty() && gml_tags().count(local)) {
-      b->foreign_gml_ns = std::string(name, static_cast<std::size_t>(sp - name));
+    } else if (ns == Ns::Other && b && b->foreign_gml_ns.empty() && citygml::gml_tag(local) != Tag::None) {
+      b->foreign_gml_ns = std::string(split.uri);
     } else if (ns == Ns::Gml) {
-      auto it = gml_tags().find(local);
-      Tag t = it == gml_tags().end() ? Tag::None : it->second;
+      Tag t = citygml::gml_tag(local);
       f.tag = t;
       if (b) {
         if (a.gml_id) ids_.push_back(IdMark{a.gml_id, depth, face_count(*b, f.excluded), f.excluded});
@@ -952,7 +796,9 @@ class Reader {
     in_polygon_ = true;
     poly_ok_ = true;
     poly_depth_ = frames_.size() + 1;
-    poly_rings_.clear();
+    poly_points_.clear();
+    poly_ring_ends_.clear();
+    poly_exterior_ = 0;
     poly_has_exterior_ = false;
     poly_id_ = id ? id : "";
     ring_role_ = 0;
@@ -1047,10 +893,10 @@ class Reader {
         return;
       }
       poly_has_exterior_ = true;
-      poly_rings_.insert(poly_rings_.begin(), ring_);
-    } else {
-      poly_rings_.push_back(ring_);
+      poly_exterior_ = poly_ring_ends_.size();
     }
+    poly_points_.insert(poly_points_.end(), ring_.begin(), ring_.end());
+    poly_ring_ends_.push_back(static_cast<std::uint32_t>(poly_points_.size()));
   }
 
   void finish_polygon(BuildingCtx& b, const Frame& f) {
@@ -1060,9 +906,35 @@ class Reader {
       b.defect("BAD_POLYGON", "polygon " + poly_label() + " has no exterior ring; dropped");
       return;
     }
-    if (f.flip)
-      for (auto& r : poly_rings_) std::reverse(r.begin() + 1, r.end());
-    (f.excluded ? b.side : b.mesh).add_face(poly_rings_, f.kind, f.lod);
+    add_polygon_face(f.excluded ? b.side : b.mesh, f);
+  }
+
+  /// The polygon's rings as one face, the exterior first, then the holes in document order; an
+  /// orientation="-" surface reversed (the first point kept). What Mesh::add_face makes, without a
+  /// vector per ring.
+  void add_polygon_face(Mesh& m, const Frame& f) {
+    MeshFace face;
+    face.first_ring = static_cast<std::uint32_t>(m.ring_count());
+    face.ring_count = static_cast<std::uint32_t>(poly_ring_ends_.size());
+    face.kind = f.kind;
+    face.lod = f.lod;
+    auto put = [&](std::size_t r) {
+      const std::size_t begin = r == 0 ? 0 : poly_ring_ends_[r - 1], end = poly_ring_ends_[r];
+      auto push = [&](const Point3& p) {
+        m.indices.push_back(static_cast<std::uint32_t>(m.vertices.size()));
+        m.vertices.push_back(p);
+      };
+      push(poly_points_[begin]);
+      if (f.flip)
+        for (std::size_t k = end - 1; k > begin; --k) push(poly_points_[k]);
+      else
+        for (std::size_t k = begin + 1; k < end; ++k) push(poly_points_[k]);
+      m.ring_offsets.push_back(static_cast<std::uint32_t>(m.indices.size()));
+    };
+    put(poly_exterior_);
+    for (std::size_t r = 0; r < poly_ring_ends_.size(); ++r)
+      if (r != poly_exterior_) put(r);
+    m.faces.push_back(face);
   }
 
   std::string name_;
@@ -1072,6 +944,7 @@ class Reader {
   SourceInfo& info_;
   CityGmlChunkWatch* watch_ = nullptr;
   XML_Parser parser_ = nullptr;
+  NameSplitter names_;
   std::exception_ptr pending_exception_;
   std::string stop_reason_;
 
@@ -1098,7 +971,9 @@ class Reader {
   std::size_t poly_depth_ = 0;
   int ring_role_ = 0;  // 1 exterior, 2 interior
   std::string poly_id_;
-  std::vector<std::vector<Point3>> poly_rings_;
+  std::vector<Point3> poly_points_;             // the polygon's rings one after the other
+  std::vector<std::uint32_t> poly_ring_ends_;   // where each ring ends in poly_points_
+  std::size_t poly_exterior_ = 0;               // which ring is the exterior
   std::vector<Point3> ring_;
 
   bool in_envelope_ = false, env_done_ = false;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "citygml/coordinates.h"
 
+#include "citygml/decimal.h"
+
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -10,10 +12,14 @@ namespace {
 
 inline bool is_space(char c) { return c == ' ' || c == '\n' || c == '\t' || c == '\r'; }
 
-inline CoordStatus parse_one(const char*& p, const char* end, std::vector<double>& out) {
+/// `fast`: try parse_decimal's fast path; cleared once a number of the list needed from_chars (the
+/// numbers of one list are written alike). Both give the same double.
+inline CoordStatus parse_one(const char*& p, const char* end, std::vector<double>& out, bool& fast) {
   if (*p == '+') ++p;  // from_chars refuses a leading '+'; xs:double allows it
   double v;
-  auto [next, ec] = std::from_chars(p, end, v);
+  bool slow = false;
+  auto [next, ec] = fast ? parse_decimal(p, end, v, &slow) : std::from_chars(p, end, v);
+  if (slow) fast = false;
   if (ec != std::errc() || (next != end && !is_space(*next))) {
     if (ec == std::errc::result_out_of_range) return CoordStatus::NotFinite;
     return CoordStatus::BadNumber;
@@ -29,10 +35,11 @@ inline CoordStatus parse_one(const char*& p, const char* end, std::vector<double
 CoordStatus parse_numbers(std::string_view text, std::vector<double>& out) {
   const char* p = text.data();
   const char* end = p + text.size();
+  bool fast = true;
   for (;;) {
     while (p < end && is_space(*p)) ++p;
     if (p == end) return CoordStatus::Ok;
-    CoordStatus s = parse_one(p, end, out);
+    CoordStatus s = parse_one(p, end, out, fast);
     if (s != CoordStatus::Ok) return s;
   }
 }

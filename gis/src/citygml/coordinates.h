@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
-// Number parsing for gml:posList, gml:pos and gml:coordinates (issue 6). std::from_chars: no locale,
-// no allocation, exact rounding.
+// Number parsing for gml:posList, gml:pos and gml:coordinates (issue 6). parse_decimal (decimal.h): no
+// locale, no allocation, correctly rounded like strtod.
 #include <cstddef>
 #include <string_view>
 #include <vector>

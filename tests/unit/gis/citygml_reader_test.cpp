@@ -412,6 +412,27 @@ TEST(CityGmlInline, CityGml3DefaultNamespaceAndAttributes) {
   EXPECT_DOUBLE_EQ(h.meshes[0].measured_height, 12.5);
 }
 
+// Names are split at their own namespace URI, even where another URI of the document is a prefix of it
+// (element_names.cpp remembers the URIs it has seen: GML 3.1's is a prefix of GML 3.2's).
+TEST(CityGmlInline, NamespaceUrisThatArePrefixesOfOthersAreToldApart) {
+  std::string square = square_poslist();
+  for (std::string::size_type k; (k = square.find("gml:")) != std::string::npos;) square.replace(k, 4, "g32:");
+  const std::string xml = doc(
+      "<gml:boundedBy><gml:Envelope srsName=\"EPSG:25832\"><gml:lowerCorner>0 0 0</gml:lowerCorner>"
+      "<gml:upperCorner>10 10 0</gml:upperCorner></gml:Envelope></gml:boundedBy>"
+      "<core:cityObjectMember><bldg:Building gml:id=\"B\" xmlns:g32=\"http://www.opengis.net/gml/3.2\">"
+      "<bldg:boundedBy><bldg:GroundSurface><bldg:lod2MultiSurface><g32:MultiSurface><g32:surfaceMember>" +
+      square +
+      "</g32:surfaceMember></g32:MultiSurface></bldg:lod2MultiSurface></bldg:GroundSurface></bldg:boundedBy>"
+      "</bldg:Building></core:cityObjectMember>");
+  ReadResult r = read_xml(xml);
+  EXPECT_TRUE(r.info.has_envelope);
+  ASSERT_EQ(r.meshes.size(), 1u);
+  EXPECT_TRUE(r.problems.empty()) << r.problems[0].code << ": " << r.problems[0].reason;
+  EXPECT_EQ(faces_of_kind(r.meshes[0], SurfaceKind::Ground), 1u);
+  EXPECT_EQ(r.meshes[0].vertices.size(), 4u);
+}
+
 TEST(CityGmlInline, TinReliefAndOtherFeaturesAreSkipped) {
   std::string tin =
       "<core:cityObjectMember><dem:ReliefFeature xmlns:dem=\"http://www.opengis.net/citygml/relief/2.0\">"
