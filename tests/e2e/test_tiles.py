@@ -141,3 +141,19 @@ def test_tiles_on_refuses_what_needs_everything(tmp_path):
         assert p.returncode == 1 and words in p.stderr, p.stderr
     p = run([BIN, "--tiles", "on", "-f", "CSV", tmp_path / "y", src, "footprints"], check=False)
     assert p.returncode == 1 and "footprints layer" in p.stderr, p.stderr
+
+
+def test_a_bad_tile_is_a_problem_and_the_rest_is_written(tmp_path):
+    """A tile that cannot be read is a problem record naming it; the other tiles' plans are all there."""
+    folder = tmp_path / "tiles"
+    folder.mkdir()
+    for tile in sorted((SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles").glob("*.gml")):
+        (folder / tile.name).symlink_to(tile)
+    (folder / "LoD1_99999999_broken.gml").write_text('<?xml version="1.0"?>\n<CityModel><cityObjectMember><bldg')
+    one = outputs(tmp_path, "one", folder, "--tiles", "off")
+    tiled = outputs(tmp_path, "tiled", folder, "--tiles", "on")
+    assert_same(one, tiled)
+    whole = outputs(tmp_path, "whole", SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", "--tiles", "on")
+    assert tiled[0] == whole[0]
+    assert any(p[2] == "UNREADABLE_FILE" for p in tiled[2]), tiled[2]
+    assert tiled[3]["tiles"]["tiles"] == 5
