@@ -11,6 +11,7 @@
 #include <groundplan/gis/geos_reference.h>
 #include <groundplan/gis/lod_choice.h>
 #include <groundplan/gis/pipeline.h>
+#include <groundplan/gis/tiled.h>
 
 #include <CLI/CLI.hpp>
 #include <gdal_utils.h>
@@ -175,10 +176,10 @@ bool vector_translate(const std::string& dst, GDALDatasetH src, const std::vecto
   return CPLGetLastErrorType() < CE_Failure;
 }
 
-void print_problems(const PipelineResult& r) {
+void print_problems(const std::vector<groundplan::Problem>& problems) {
   constexpr std::size_t kShown = 20;
-  for (std::size_t i = 0; i < r.problems.size() && i < kShown; ++i) {
-    const auto& p = r.problems[i];
+  for (std::size_t i = 0; i < problems.size() && i < kShown; ++i) {
+    const auto& p = problems[i];
     if (p.source_id.empty())
       std::fprintf(stderr, "groundplan: %s: %s: %s\n", p.file.c_str(), p.code == "NOTE" ? "note" : p.code.c_str(),
                    p.reason.c_str());
@@ -186,15 +187,15 @@ void print_problems(const PipelineResult& r) {
       std::fprintf(stderr, "groundplan: %s: building %s: %s (%s)\n", p.file.c_str(), p.source_id.c_str(),
                    p.reason.c_str(), p.code.c_str());
   }
-  if (r.problems.size() > kShown)
+  if (problems.size() > kShown)
     std::fprintf(stderr, "groundplan: ... and %zu more problems: write the 'problems' layer to see them all\n",
-                 r.problems.size() - kShown);
+                 problems.size() - kShown);
 }
 
 /// Problems proper, without notes (a CRS guess is worth saying but is no defect).
-std::size_t count_defects(const PipelineResult& r) {
+std::size_t count_defects(const std::vector<groundplan::Problem>& problems) {
   std::size_t n = 0;
-  for (const auto& p : r.problems) n += p.code != "NOTE";
+  for (const auto& p : problems) n += p.code != "NOTE";
   return n;
 }
 
@@ -279,7 +280,7 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                  {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
                  {"ground_plans", result.plans.size()},
-                 {"holes", count_holes(result)},          {"problems", count_defects(result)}};
+                 {"holes", count_holes(result)},          {"problems", count_defects(result.problems)}};
   j["timings_s"] = {{"read", result.timings.read_s},     {"footprints", result.timings.footprints_s},
                     {"blocks", result.timings.blocks_s}, {"union", result.timings.union_s},
                     {"level_of_detail", result.timings.lod_s}, {"write", write_s},
@@ -303,6 +304,147 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
     return false;
   }
   return true;
+}
+
+struct WriteOutcome {
+  bool ok = false;
+  int usage_error = FALSE;
+  bool own_index = false;
+  double write_s = 0, index_s = 0;
+  groundplan::cli::RtreeBuild built;
+  std::string members_note;
+};
+
+/// Writes our dataset (taking it: closed here) through GDAL's ogr2ogr with the user's options, packs a new
+/// GeoPackage's spatial index, and writes the full member lists beside a DBF whose id lists were cut.
+WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads) {
+  WriteOutcome w;
+  const bool dbf = writes_dbf(ogr);
+  GDALDatasetH src_h = GDALDataset::ToHandle(ds);
+  std::vector<std::string> vt_args = ogr.options;
+  const bool own_index = packs_gpkg_index(ogr);
+  w.own_index = own_index;
+  if (own_index) vt_args.insert(vt_args.end(), {"-lco", "SPATIAL_INDEX=NO"});
+  if (!ogr.layer_named) vt_args.push_back("ground_plans");
+  const auto t_write = clock::now();
+  int usage_error = FALSE;
+  bool write_ok = vector_translate(ogr.dst, src_h, vt_args, ogr.progress && !ogr.quiet, &usage_error);
+  double index_s = 0;
+  groundplan::cli::RtreeBuild& built = w.built;
+  if (write_ok && own_index) {
+    const auto t_index = clock::now();
+    const bool indexed = groundplan::cli::index_new_gpkg(
+        ogr.dst, static_cast<int>(groundplan::gis::thread_count(threads)), built);
+    if (built.by_gdal)
+      std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL built it instead\n",
+                   built.error.c_str());
+    if (!indexed) std::fprintf(stderr, "groundplan: warning: %s has no spatial index\n", ogr.dst.c_str());
+    index_s = seconds_since(t_index);
+  }
+  // DBF fields hold 254 characters: cut lists are marked "...(+N)" and the full lists go beside them.
+  std::string& members_note = w.members_note;
+  const bool members_named =
+      std::find(ogr.layers.begin(), ogr.layers.end(), std::string("plan_members")) != ogr.layers.end();
+  if (write_ok && dbf && ds->id_lists_cut() && !members_named) {
+    std::filesystem::path dst(ogr.dst);
+    const bool single_file = lower(dst.extension().string()) == ".shp";
+    const std::string dir = single_file ? (dst.has_parent_path() ? dst.parent_path().string() : ".") : ogr.dst;
+    const std::string name = (single_file ? dst.stem().string() : std::string("ground_plans")) + "_members";
+    std::vector<std::string> args = {"-f", "ESRI Shapefile", "-nln", name, "plan_members"};
+    if (std::find(ogr.options.begin(), ogr.options.end(), "-overwrite") != ogr.options.end())
+      args.insert(args.begin(), "-overwrite");
+    write_ok = vector_translate(dir, src_h, args, false, &usage_error);
+    members_note = std::to_string(ds->id_lists_cut()) +
+                   " plans list more building ids than a DBF field holds (254 characters): their building_ids end "
+                   "in '...(+N)'; the full lists are in " +
+                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id)";
+  }
+  GDALClose(src_h);
+  w.ok = write_ok;
+  w.usage_error = usage_error;
+  w.write_s = seconds_since(t_write);
+  w.index_s = index_s;
+  return w;
+}
+
+/// --tiles auto: the tiled run from this much input in at least two files. Below it one process holds the
+/// footprints easily (about 2.1 KiB a building: 1 GiB of CityGML LoD1 is about 1.5M buildings, 3 GiB of memory).
+constexpr std::uint64_t kAutoTileBytes = std::uint64_t{1} << 30;
+
+/// Why the tiled run cannot give what was asked for (empty: it can).
+std::string tiles_ruled_out(const PipelineOptions& options, const Ogr2ogrArgs& ogr, bool verify, bool preview) {
+  if (options.detail.any()) return "a level of detail (--snap, --close-gaps, --simplify, --min-area ...) looks past a plan's own box";
+  if (verify) return "--verify compares all footprints with all plans at once";
+  if (preview) return "--preview draws all footprints at once";
+  if (std::find(ogr.layers.begin(), ogr.layers.end(), std::string("footprints")) != ogr.layers.end())
+    return "the footprints layer needs every footprint at once";
+  return {};
+}
+
+/// The tiled run (issue 15, gis/tiled.h): same plans with bounded memory; the final plans of all tiles first,
+/// then the plans from seams. --stats says how many were final at once and how many were seams.
+int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std::string& stats_path,
+              const groundplan::Progress& progress) {
+  const double cpu0 = groundplan::gis::process_cpu_seconds();
+  const auto t0 = clock::now();
+  std::shared_ptr<const groundplan::gis::TiledResult> result = groundplan::gis::run_pipeline_tiled(options, progress);
+  const groundplan::gis::TiledResult& r = *result;
+  auto stats = [&](double write_s, double index_s, const groundplan::cli::RtreeBuild* index) {
+    if (stats_path.empty()) return true;
+    const groundplan::gis::TileStats& t = r.tiles;
+    nlohmann::json j;
+    j["counts"] = {{"buildings", r.buildings_read}, {"footprints", r.footprints}, {"dropped", r.buildings_dropped},
+                   {"blocks", r.blocks}, {"ground_plans", r.plan_count()}, {"problems", count_defects(r.problems)}};
+    j["timings_s"] = {{"read", r.timings.read_s}, {"footprints", r.timings.footprints_s}, {"blocks", r.timings.blocks_s},
+                      {"union", r.timings.union_s}, {"write", write_s}, {"spatial_index", index_s},
+                      {"total", seconds_since(t0)}, {"cpu", groundplan::gis::process_cpu_seconds() - cpu0}};
+    j["reading"] = {{"threads", r.reading.threads}, {"files", r.reading.files}, {"bytes", r.reading.bytes},
+                    {"files_chunked", r.reading.files_chunked}, {"chunks", r.reading.chunks}};
+    j["tiles"] = {{"tiles", t.tiles}, {"tile_plans", t.tile_plans}, {"final_at_once", t.final_plans},
+                  {"seam_plans", t.seam_plans}, {"seam_footprints", t.seam_footprints},
+                  {"plans_from_seams", t.reduced_plans}, {"max_tile_footprints", t.max_tile_footprints},
+                  {"tiles_in_flight", t.tiles_in_flight}, {"spill_bytes", t.spill_bytes},
+                  {"map_s", t.map_s}, {"reduce_s", t.reduce_s}};
+    j["raster_backend"] = r.raster_backend;
+    if (index)
+      j["spatial_index"] = {{"tables", index->tables}, {"entries", index->entries}, {"error", index->error},
+                            {"by_gdal", index->by_gdal}};
+    std::ofstream f(stats_path);
+    f << j.dump(2) << '\n';
+    if (!f) std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());
+    return static_cast<bool>(f);
+  };
+  if (r.footprints == 0) {
+    if (!ogr.quiet) print_problems(r.problems);
+    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
+                 r.buildings_read == 0
+                     ? "no building found"
+                     : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+    stats(0, 0, nullptr);
+    return 1;
+  }
+  auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
+                                                             result, writes_dbf(ogr) ? 254 : 0, options.threads);
+  const WriteOutcome w = write_output(ds, ogr, options.threads);
+  if (!w.ok) {
+    std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr.dst.c_str(),
+                 w.usage_error ? " (bad ogr2ogr options)" : "");
+    return 1;
+  }
+  if (!w.members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", w.members_note.c_str());
+  if (!ogr.quiet) {
+    const groundplan::gis::TileStats& t = r.tiles;
+    std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles\n", r.buildings_read, ogr.src.c_str(),
+                r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles);
+    std::printf("groundplan: %zu footprints -> %zu ground plans (%zu final at once, %zu from %zu seam plans of "
+                "%zu footprints); %zu problems\n",
+                r.footprints, r.plan_count(), t.final_plans, t.reduced_plans, t.seam_plans, t.seam_footprints,
+                count_defects(r.problems));
+    std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", ogr.dst.c_str(),
+                seconds_since(t0), t.map_s, t.reduce_s, w.write_s);
+    print_problems(r.problems);
+  }
+  return stats(w.write_s, w.index_s, w.own_index ? &w.built : nullptr) ? 0 : 1;
 }
 
 int run(int argc, char** argv) {
@@ -346,6 +488,12 @@ int run(int argc, char** argv) {
   app.add_flag("--verify", verify, "Compare with GEOS UnaryUnion of the same footprints; exit 3 on mismatch");
   app.add_option("--stats", stats_path, "Write counts and per-stage timings to this JSON file");
   app.add_option("--preview", preview_path, "Write a PNG map of the plans (holes open, problem buildings in red)");
+  std::string tiles = "auto";
+  app.add_option("--tiles", tiles,
+                 "auto|on|off: map the input files one tile at a time with bounded memory, the plans crossing tile "
+                 "edges united at the end (same plans; final plans first, then those from seams). auto: on from "
+                 "1 GiB of input in 2 or more files, unless --verify, --preview, a level of detail or the footprints "
+                 "layer needs everything at once");
   int threads = 0;
   std::int64_t read_chunk_bytes = 0, read_range_features = 0;
   auto* o_threads = app.add_option("--threads", threads, "Threads for every stage (0 = all cores; default: GDAL's "
@@ -433,6 +581,27 @@ int run(int argc, char** argv) {
   options.read_chunk_bytes = read_chunk_bytes;
   options.read_range_features = read_range_features;
 
+  // Tiles (issue 15): a large folder of tiles is mapped tile by tile with bounded memory (same plans).
+  const std::string tiles_mode = lower(tiles);
+  if (tiles_mode != "auto" && tiles_mode != "on" && tiles_mode != "off")
+    throw groundplan::InvalidArgument("--tiles: '" + tiles + "' is not one of auto, on, off");
+  const std::string no_tiles = tiles_ruled_out(options, ogr, verify, !preview_path.empty());
+  if (tiles_mode == "on" && !no_tiles.empty())
+    throw groundplan::InvalidArgument("--tiles on: " + no_tiles + "; use --tiles off");
+  bool tiled = tiles_mode == "on";
+  if (tiles_mode == "auto" && no_tiles.empty()) {
+    std::size_t files = 0;
+    tiled = groundplan::gis::input_bytes(options.inputs, &files) >= kAutoTileBytes && files >= 2;
+  }
+  if (tiled) {
+    groundplan::Progress tile_progress;
+    if (ogr.progress && !ogr.quiet)
+      tile_progress = groundplan::Progress([](double f, const char* msg) {
+        return GDALTermProgress(f, msg, nullptr) != FALSE;
+      });
+    return run_tiled(options, ogr, stats_path, tile_progress);
+  }
+
   const double cpu0 = groundplan::gis::process_cpu_seconds();
   const auto t0 = clock::now();
   groundplan::Progress progress;
@@ -446,7 +615,7 @@ int run(int argc, char** argv) {
   // Nothing usable (every building a problem, or no building at all): say so and fail, without
   // writing an empty result that would look like success (issue 8). The problems say why.
   if (result.footprints.empty()) {
-    if (!ogr.quiet) print_problems(result);
+    if (!ogr.quiet) print_problems(result.problems);
     std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
                  result.buildings_read == 0
                      ? "no building found"
@@ -458,54 +627,18 @@ int run(int argc, char** argv) {
   }
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
-  const bool dbf = writes_dbf(ogr);
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
-                                                             result_ptr, dbf ? 254 : 0, options.threads);
-  GDALDatasetH src_h = GDALDataset::ToHandle(ds);
-  std::vector<std::string> vt_args = ogr.options;
-  const bool own_index = packs_gpkg_index(ogr);
-  if (own_index) vt_args.insert(vt_args.end(), {"-lco", "SPATIAL_INDEX=NO"});
-  if (!ogr.layer_named) vt_args.push_back("ground_plans");
-  const auto t_write = clock::now();
-  int usage_error = FALSE;
-  bool write_ok = vector_translate(ogr.dst, src_h, vt_args, ogr.progress && !ogr.quiet, &usage_error);
-  double index_s = 0;
-  groundplan::cli::RtreeBuild built;
-  if (write_ok && own_index) {
-    const auto t_index = clock::now();
-    const bool indexed = groundplan::cli::index_new_gpkg(
-        ogr.dst, static_cast<int>(groundplan::gis::thread_count(options.threads)), built);
-    if (built.by_gdal)
-      std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL built it instead\n",
-                   built.error.c_str());
-    if (!indexed) std::fprintf(stderr, "groundplan: warning: %s has no spatial index\n", ogr.dst.c_str());
-    index_s = seconds_since(t_index);
-  }
-
-  // DBF fields hold 254 characters: cut lists are marked "...(+N)" and the full lists go beside them.
-  std::string members_note;
-  const bool members_named =
-      std::find(ogr.layers.begin(), ogr.layers.end(), std::string("plan_members")) != ogr.layers.end();
-  if (write_ok && dbf && ds->id_lists_cut() && !members_named) {
-    std::filesystem::path dst(ogr.dst);
-    const bool single_file = lower(dst.extension().string()) == ".shp";
-    const std::string dir = single_file ? (dst.has_parent_path() ? dst.parent_path().string() : ".") : ogr.dst;
-    const std::string name = (single_file ? dst.stem().string() : std::string("ground_plans")) + "_members";
-    std::vector<std::string> args = {"-f", "ESRI Shapefile", "-nln", name, "plan_members"};
-    if (std::find(ogr.options.begin(), ogr.options.end(), "-overwrite") != ogr.options.end())
-      args.insert(args.begin(), "-overwrite");
-    write_ok = vector_translate(dir, src_h, args, false, &usage_error);
-    members_note = std::to_string(ds->id_lists_cut()) +
-                   " plans list more building ids than a DBF field holds (254 characters): their building_ids end "
-                   "in '...(+N)'; the full lists are in " +
-                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id)";
-  }
-  GDALClose(src_h);
-  const double write_s = seconds_since(t_write);
+                                                             result_ptr, writes_dbf(ogr) ? 254 : 0, options.threads);
+  const WriteOutcome w = write_output(ds, ogr, options.threads);
+  const bool write_ok = w.ok;
+  const double write_s = w.write_s, index_s = w.index_s;
+  const groundplan::cli::RtreeBuild& built = w.built;
+  const bool own_index = w.own_index;
+  const std::string& members_note = w.members_note;
   const double total_s = seconds_since(t0), cpu_s = groundplan::gis::process_cpu_seconds() - cpu0;  // before --verify and --preview
   if (!write_ok) {
     std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr.dst.c_str(),
-                 usage_error ? " (bad ogr2ogr options)" : "");
+                 w.usage_error ? " (bad ogr2ogr options)" : "");
     return 1;
   }
   if (!members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", members_note.c_str());
@@ -515,7 +648,7 @@ int run(int argc, char** argv) {
     std::printf("groundplan: read %zu buildings from %s (CRS %s)\n", result.buildings_read, ogr.src.c_str(),
                 result.crs_name.empty() ? "unknown" : result.crs_name.c_str());
     std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %zu problems\n",
-                result.footprints.size(), result.plans.size(), holes, count_defects(result));
+                result.footprints.size(), result.plans.size(), holes, count_defects(result.problems));
     std::printf(
         "groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, blocks %.2f s (%zu, %s), union %.2f s, "
         "write %.2f s)\n",
@@ -525,7 +658,7 @@ int run(int argc, char** argv) {
     if (options.detail.any())
       std::printf("groundplan: level of detail (%.2f s): %s\n", result.timings.lod_s,
                   lod_summary(options.detail, result.lod_stats).c_str());
-    print_problems(result);
+    print_problems(result.problems);
   }
 
   if (!preview_path.empty()) groundplan::cli::write_preview_png(result, preview_path);

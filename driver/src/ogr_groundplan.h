@@ -4,6 +4,7 @@
 // (ground_plans, footprints, problems, plan_members). The result is computed when the first dataset of an
 // input is opened and shared by later opens (result_cache.h).
 #include <groundplan/gis/pipeline.h>
+#include <groundplan/gis/tiled.h>
 
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
@@ -72,8 +73,14 @@ class OGRGroundPlanDataSource final : public GDALDataset {
   OGRGroundPlanDataSource(const std::string& description, std::shared_ptr<const gis::PipelineResult> result,
                           std::size_t max_id_list_chars = 0, int threads = 0);
 
-  /// Plans whose building_ids were cut (see max_id_list_chars).
-  std::size_t id_lists_cut() const { return id_lists_cut_; }
+  /// The layers of a tiled run (issue 15, gis/tiled.h): ground_plans, problems and plan_members, each plan
+  /// read back from the run's temporary file when the writer asks for it. There is no footprints layer: the
+  /// tiled run keeps no footprints.
+  OGRGroundPlanDataSource(const std::string& description, std::shared_ptr<const gis::TiledResult> tiled,
+                          std::size_t max_id_list_chars = 0, int threads = 0);
+
+  /// Plans whose building_ids were cut (see max_id_list_chars); a tiled run's are counted as they are written.
+  std::size_t id_lists_cut() const;
 
   int GetLayerCount() override { return static_cast<int>(layers_.size()); }
   OGRLayer* GetLayer(int i) override;
@@ -86,6 +93,8 @@ class OGRGroundPlanDataSource final : public GDALDataset {
  private:
   std::vector<std::unique_ptr<OGRGroundPlanLayer>> layers_;
   std::shared_ptr<const gis::PipelineResult> result_;
+  std::shared_ptr<const gis::TiledResult> tiled_;
+  std::shared_ptr<std::vector<std::uint8_t>> cut_flags_;  // tiled: plan i's id list was cut
   std::vector<GIntBig> plan_of_;  // the plan (gp_id) that holds each footprint; 0: none
   OGRSpatialReference srs_;
   std::size_t id_lists_cut_ = 0;

@@ -2,6 +2,7 @@
 // The dataset behind GROUNDPLAN:<path>: takes the pipeline's result on open (computed once per input and
 // options in a process: result_cache.h) and serves its layers.
 #include "ogr_groundplan.h"
+#include "ogr_features.h"
 #include "open_options.h"
 #include "result_cache.h"
 
@@ -23,7 +24,9 @@ OGRLinearRing* to_ogr_ring(const Ring& ring) {
   return r;
 }
 
-OGRPolygon* to_ogr_polygon(const Polygon& poly) {
+}  // namespace
+
+OGRPolygon* detail::to_ogr_polygon(const Polygon& poly) {
   auto* g = new OGRPolygon();
   if (poly.outer.size() < 3) return g;
   g->addRingDirectly(to_ogr_ring(poly.outer));
@@ -32,14 +35,14 @@ OGRPolygon* to_ogr_polygon(const Polygon& poly) {
   return g;
 }
 
-void add_field(OGRFeatureDefn* defn, const char* name, OGRFieldType type, int width = 0) {
+void detail::add_field(OGRFeatureDefn* defn, const char* name, OGRFieldType type, int width) {
   OGRFieldDefn f(name, type);
   if (width) f.SetWidth(width);
   defn->AddFieldDefn(&f);
 }
 
 /// "a,b,c,d" cut to at most `max` characters at a comma, ending in ",...(+N)" with N ids left out.
-std::string cut_id_list(const std::string& ids, std::size_t count, std::size_t max) {
+std::string detail::cut_id_list(const std::string& ids, std::size_t count, std::size_t max) {
   if (max == 0 || ids.size() <= max) return ids;
   std::size_t kept = 0, end = 0;
   for (std::size_t pos = 0; pos != std::string::npos;) {
@@ -54,6 +57,8 @@ std::string cut_id_list(const std::string& ids, std::size_t count, std::size_t m
   return ids.substr(0, end) + (kept ? "," : "") + "...(+" + std::to_string(count - kept) + ")";
 }
 
+namespace {
+
 /// The envelope of `rings` (outer rings of plans or footprint polygons).
 template <class ForEachRing>
 OGREnvelope envelope_of(ForEachRing&& for_each_ring) {
@@ -65,6 +70,10 @@ OGREnvelope envelope_of(ForEachRing&& for_each_ring) {
 }
 
 }  // namespace
+
+using detail::add_field;
+using detail::cut_id_list;
+using detail::to_ogr_polygon;
 
 OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
                                                  std::shared_ptr<const gis::PipelineResult> result,

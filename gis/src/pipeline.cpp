@@ -8,6 +8,7 @@
 #include <groundplan/gis/reader.h>
 
 #include "pipeline/file_reading.h"
+#include "pipeline/inputs.h"
 
 #include <cpl_string.h>
 #include <cpl_vsi.h>
@@ -51,7 +52,9 @@ bool is_ogr_input_name(const std::string& name) {
 /// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF, CityJSON;
 /// not .dae, which belong to a .kml beside them; Shapefile, GeoPackage, FlatGeobuf, GeoJSON) sorted by name,
 /// a .zip as its city files.
-std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
+}  // namespace
+
+std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
     std::error_code ec;
@@ -99,8 +102,6 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs, s
   }
   return files;
 }
-
-}  // namespace
 
 const char* to_string(FootprintMode mode) {
   switch (mode) {
@@ -168,9 +169,7 @@ bool raster_mode_from_string(const std::string& s) {
   throw InvalidArgument("resolution mode: '" + s + "' is not one of exact, raster");
 }
 
-namespace {
-
-std::uint64_t total_bytes(const std::vector<std::string>& files) {
+std::uint64_t detail::total_bytes(const std::vector<std::string>& files) {
   std::uint64_t total = 0;
   for (const std::string& f : files) {
     VSIStatBufL st;
@@ -181,8 +180,8 @@ std::uint64_t total_bytes(const std::vector<std::string>& files) {
 
 /// Adds one file's outcome to the result, in file order, and fixes the working CRS from it the way
 /// reading the files one after the other always has: the first georeferenced file decides (or -t_srs).
-void merge_file(detail::FileRead&& r, const std::string& file, detail::ReadContext& context, PipelineResult& result,
-                std::size_t& files_failed, std::string& first_failure) {
+void detail::merge_file(detail::FileRead&& r, const std::string& file, detail::ReadContext& context,
+                        PipelineResult& result, std::size_t& files_failed, std::string& first_failure) {
   result.timings.footprints_s += r.footprint_wait_s;
   result.buildings_read += r.buildings_read;
   result.buildings_dropped += r.buildings_dropped;
@@ -213,13 +212,15 @@ void merge_file(detail::FileRead&& r, const std::string& file, detail::ReadConte
   }
 }
 
+namespace {
+
 PipelineResult run(const PipelineOptions& options, const Progress& progress, std::size_t threads) {
   const double cpu0 = process_cpu_seconds();
   PipelineResult result;
-  const std::vector<std::string> files = expand_inputs(options.inputs, result.problems);
+  const std::vector<std::string> files = detail::expand_inputs(options.inputs, result.problems);
   result.reading.files = files.size();
   result.reading.threads = threads;
-  result.reading.bytes = total_bytes(files);
+  result.reading.bytes = detail::total_bytes(files);
 
   // One working CRS for all inputs: the first file decides it (or -t_srs does); later files are
   // transformed into it. Until it is known the files are read one by one (each may still be read in
@@ -234,7 +235,7 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   progress.report(0, "reading");
   std::size_t fi = 0;
   for (; fi < files.size() && context.working_definition.empty(); ++fi)
-    merge_file(detail::read_file(files[fi], options, context, threads, 0, bytes), files[fi], context, result,
+    detail::merge_file(detail::read_file(files[fi], options, context, threads, 0, bytes), files[fi], context, result,
                files_failed, first_failure);
   if (fi < files.size()) {
     // Largest first, so that a big file does not start last; at most one task a thread in flight, so
@@ -256,7 +257,7 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
         reads[order[k]] = detail::read_file(files[order[k]], options, fixed, threads, shared, bytes);
     }, tbb::simple_partitioner());
     for (; fi < files.size(); ++fi)
-      merge_file(std::move(reads[fi]), files[fi], context, result, files_failed, first_failure);
+      detail::merge_file(std::move(reads[fi]), files[fi], context, result, files_failed, first_failure);
   }
   if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
   result.timings.read_s = std::max(0.0, seconds_since(t_read) - result.timings.footprints_s);

@@ -1,0 +1,18 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// Feature pieces shared by the dataset's two sources (a PipelineResult, a TiledResult).
+#include <groundplan/types.h>
+
+#include <ogrsf_frmts.h>
+
+#include <string>
+
+namespace groundplan::driver::detail {
+
+/// An OGR polygon (rings closed); empty when the outer ring has fewer than 3 points.
+OGRPolygon* to_ogr_polygon(const Polygon& poly);
+void add_field(OGRFeatureDefn* defn, const char* name, OGRFieldType type, int width = 0);
+/// "a,b,c,d" cut to at most `max` characters at a comma, ending in ",...(+N)" with N ids left out (max 0: whole).
+std::string cut_id_list(const std::string& ids, std::size_t count, std::size_t max);
+
+}  // namespace groundplan::driver::detail

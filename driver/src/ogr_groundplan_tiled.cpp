@@ -1,0 +1,113 @@
+// SPDX-License-Identifier: MIT
+// The dataset's layers over a tiled run (issue 15): plans come from TiledResult::plan(i), read back from the
+// run's temporary file by the batch builders (several threads at once), so memory holds one batch of plans.
+#include "ogr_features.h"
+#include "ogr_groundplan.h"
+
+#include <algorithm>
+
+namespace groundplan::driver {
+
+std::size_t OGRGroundPlanDataSource::id_lists_cut() const {
+  if (!cut_flags_) return id_lists_cut_;
+  return static_cast<std::size_t>(std::count(cut_flags_->begin(), cut_flags_->end(), std::uint8_t{1}));
+}
+
+OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
+                                                 std::shared_ptr<const gis::TiledResult> tiled,
+                                                 std::size_t max_id_list_chars, int threads)
+    : tiled_(std::move(tiled)) {
+  using detail::add_field;
+  SetDescription(description.c_str());
+  const gis::TiledResult* res = tiled_.get();
+  const OGRSpatialReference* srs = nullptr;
+  if (!res->crs_wkt.empty() && srs_.importFromWkt(res->crs_wkt.c_str()) == OGRERR_NONE) {
+    srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    srs = &srs_;
+  }
+  const bool dbf = max_id_list_chars > 0;
+  cut_flags_ = std::make_shared<std::vector<std::uint8_t>>(res->plan_count(), 0);
+  std::vector<std::uint8_t>* cut = cut_flags_.get();
+  auto plans = std::make_unique<OGRGroundPlanLayer>(
+      "ground_plans", wkbPolygon, srs, res->plan_count(),
+      [res, cut, max_id_list_chars](OGRFeatureDefn* defn, std::size_t i) {
+        const gis::StoredPlan sp = res->plan(i);
+        auto* f = new OGRFeature(defn);
+        std::string ids;
+        for (const std::string& id : sp.member_ids) {
+          if (!ids.empty()) ids += ',';
+          ids += id;
+        }
+        if (max_id_list_chars && ids.size() > max_id_list_chars) (*cut)[i] = 1;
+        f->SetField(0, static_cast<GIntBig>(i + 1));
+        f->SetField(1, static_cast<int>(sp.plan.members.size()));
+        f->SetField(2, sp.plan.area_m2);
+        if (!sp.member_ids.empty()) {
+          f->SetField(3, sp.min_z);
+          f->SetField(4, sp.max_z);
+        }
+        f->SetField(5, detail::cut_id_list(ids, sp.plan.members.size(), max_id_list_chars).c_str());
+        f->SetGeometryDirectly(detail::to_ogr_polygon(sp.plan.polygon));
+        return f;
+      },
+      [res] {
+        OGREnvelope e;
+        if (res->extent[0] <= res->extent[2]) {
+          e.MinX = res->extent[0];
+          e.MinY = res->extent[1];
+          e.MaxX = res->extent[2];
+          e.MaxY = res->extent[3];
+        }
+        return e;
+      },
+      threads);
+  add_field(plans->defn(), "gp_id", OFTInteger64);
+  add_field(plans->defn(), "n_parts", OFTInteger);
+  add_field(plans->defn(), "area_m2", OFTReal);
+  add_field(plans->defn(), "min_z", OFTReal);
+  add_field(plans->defn(), "max_z", OFTReal);
+  add_field(plans->defn(), dbf ? "bldg_ids" : "building_ids", OFTString);
+
+  auto problems = std::make_unique<OGRGroundPlanLayer>(
+      "problems", wkbNone, nullptr, res->problems.size(),
+      [res](OGRFeatureDefn* defn, std::size_t i) {
+        const Problem& p = res->problems[i];
+        auto* f = new OGRFeature(defn);
+        f->SetField(0, p.source_id.c_str());
+        f->SetField(1, p.file.c_str());
+        f->SetField(2, p.stage.c_str());
+        f->SetField(3, p.code.c_str());
+        f->SetField(4, p.reason.c_str());
+        return f;
+      },
+      OGRGroundPlanLayer::Extent{}, threads);
+  for (const char* name : {"source_id", "file", "stage", "code", "reason"}) add_field(problems->defn(), name, OFTString);
+
+  // Row r belongs to the plan i with members_before(i) <= r < members_before(i + 1).
+  auto members = std::make_unique<OGRGroundPlanLayer>(
+      "plan_members", wkbNone, nullptr, static_cast<std::size_t>(res->members_before(res->plan_count())),
+      [res](OGRFeatureDefn* defn, std::size_t r) {
+        std::size_t lo = 0, hi = res->plan_count();
+        while (hi - lo > 1) {
+          const std::size_t mid = lo + (hi - lo) / 2;
+          (res->members_before(mid) <= r ? lo : hi) = mid;
+        }
+        const gis::StoredPlan sp = res->plan(lo);
+        const std::size_t k = r - static_cast<std::size_t>(res->members_before(lo));
+        auto* f = new OGRFeature(defn);
+        f->SetField(0, static_cast<GIntBig>(lo) + 1);
+        f->SetField(1, static_cast<GIntBig>(sp.plan.members[k]) + 1);
+        f->SetField(2, sp.member_ids[k].c_str());
+        return f;
+      },
+      OGRGroundPlanLayer::Extent{}, threads);
+  add_field(members->defn(), "gp_id", OFTInteger64);
+  add_field(members->defn(), "fp_id", OFTInteger64);
+  add_field(members->defn(), "source_id", OFTString);
+
+  layers_.push_back(std::move(plans));
+  layers_.push_back(std::move(problems));
+  layers_.push_back(std::move(members));
+}
+
+}  // namespace groundplan::driver
