@@ -13,9 +13,9 @@
 
 namespace groundplan::detail {
 
-/// The grid pitch for coordinates of magnitude at most `max_abs`: 32 ulp(max_abs), a power of two.
+/// The grid pitch for coordinates of magnitude at most `max_abs`: 16 ulp(max_abs), a power of two.
 /// Pixel sides, centres and their differences are then exact doubles; a pixel centre is at least
-/// g/2 = 16 ulp from every rounded edge that does not pass through its pixel (the ISR guarantee).
+/// g/2 = 8 ulp from every rounded edge that does not pass through its pixel (the ISR guarantee).
 double snap_pitch(double max_abs);
 
 struct SnappedRing {
