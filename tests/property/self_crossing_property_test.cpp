@@ -11,7 +11,7 @@
 // DISABLED_ tests (run them with --gtest_also_run_disabled_tests). Branch snap-round2: 965 of 1000
 // cases strict-equal; 32 near-touch (valid output that near-touches is not snap-rounded:
 // snap_round.h kSnapNearTouch), 11 other polygon/hole counts; with near-touch snapped too (the
-// constant on) 990/1000, 1 near-touch, but 3 large_offsets cases then differ from GEOS in counts.
+// constant on) 990/1000, 1 near-touch, but large_offsets cases then differ from GEOS in counts.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -40,8 +40,8 @@ using testing::sampling_disagreements;
 constexpr int kCasesPerFamily = 1000;
 
 // Families whose output may still hold near-touch artefacts (issue 20, measured 2026-11-24 on branch
-// snap-round2, 1000 cases each): near_collinear 3 (was 679 before snap rounding), large_offsets 3
-// (was 13). Snap rounding is applied where rounded output would be invalid or overlapping; valid
+// snap-round2, 1000 cases each): near_collinear 592 (was 679 before snap rounding), large_offsets 13
+// (13). Snap rounding is applied where rounded output would be invalid or overlapping; valid
 // output that merely near-touches is kept (snap_round.h, kSnapNearTouch). Every other family has
 // none, and fails on one.
 bool near_touch_open(Family f) { return f == Family::NearCollinear || f == Family::LargeOffsets; }

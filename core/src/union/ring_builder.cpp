@@ -110,57 +110,76 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
   std::vector<std::vector<std::uint32_t>> parts_polys;
   std::vector<std::size_t> part_src;  // parts[k] has the polygons parts_polys[part_src[k]]
   std::vector<char> parts_snapped;    // parts[k] comes from snap rounding
-  // Groups of walks more than 4 pitches apart are independent: a group without a crossing point is
-  // exact and kept bit for bit even next to a snapped one (proximity_groups).
+  // Walks split as they are (crossings correctly rounded). Exact walks are the exact boundary. If some
+  // walk has a rounded crossing and the whole block's rings are not clean (clean_as_rounded: valid and
+  // disjoint), the walks are grouped by proximity (groups more than 4 pitches apart are independent)
+  // and each group with a crossing whose rings are not clean is snap-rounded; the others stay as split.
   bool any_rounded = false;
   for (const RingOut& r : rings_) any_rounded |= r.rounded;
-  std::vector<std::uint32_t> group;
-  std::vector<char> group_snapped;
-  if (any_rounded) {
-    group = proximity_groups(rings_, pitch);
-    group_snapped.assign(rings_.size(), 0);
-    for (std::size_t i = 0; i < rings_.size(); ++i) group_snapped[group[i]] |= rings_[i].rounded;
+  std::vector<std::size_t> first_part(rings_.size() + 1, 0);
+  for (std::size_t i = 0; i < rings_.size(); ++i) {
+    split_simple(rings_[i].pts, parts);
+    first_part[i + 1] = parts.size();
+  }
+  std::vector<char> walk_snapped(rings_.size(), 0);
+  if (any_rounded && !clean_as_rounded(parts, pitch, kSnapNearTouch)) {
+    const std::vector<std::uint32_t> group = proximity_groups(rings_, pitch);
+    std::vector<char> has_cross(rings_.size(), 0);
+    for (std::size_t i = 0; i < rings_.size(); ++i) has_cross[group[i]] |= rings_[i].rounded;
+    std::vector<std::vector<std::uint32_t>> members(rings_.size());
+    for (std::uint32_t i = 0; i < rings_.size(); ++i)
+      if (has_cross[group[i]]) members[group[i]].push_back(i);
+    std::vector<std::vector<Point2>> snapped_parts;
+    std::vector<std::vector<std::uint32_t>> snapped_polys;
     for (std::uint32_t gi = 0; gi < rings_.size(); ++gi) {
-      if (!group_snapped[gi]) continue;
+      if (members[gi].empty()) continue;
+      std::vector<std::vector<Point2>> as_is;
+      for (std::uint32_t i : members[gi])
+        for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) as_is.push_back(parts[k]);
+      if (members[gi].size() < rings_.size() && clean_as_rounded(as_is, pitch, kSnapNearTouch)) continue;
       std::vector<RingOut> sub;
-      for (std::size_t i = 0; i < rings_.size(); ++i)
-        if (group[i] == gi) sub.push_back(rings_[i]);
-      {
-        // crossings correctly rounded may already be clean (valid and disjoint): then the group is kept
-        // as it is, exact but for its crossing points' rounding. Near-touch alone (vertices within a
-        // pitch, valid) does not trigger snap rounding: kSnapNearTouch (snap_round.h) says why.
-        std::vector<std::vector<Point2>> as_is;
-        for (const RingOut& r : sub) split_simple(r.pts, as_is);
-        if (clean_as_rounded(as_is, pitch, kSnapNearTouch)) {
-          group_snapped[gi] = 0;
-          continue;
-        }
-      }
+      for (std::uint32_t i : members[gi]) sub.push_back(rings_[i]);
       std::vector<SnappedRing> sr;
       SnapStats ss;
       if (!snap_round(sub, pitch, sr, ss)) {
         out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
                                        "snap rounding of a boundary did not give a consistent edge graph; "
                                        "its crossing points are rounded to nearest instead"});
-        group_snapped[gi] = 0;
         continue;
       }
       stats_.snapped_groups += 1;
       stats_.rounding_repairs += ss.cancelled;
+      for (std::uint32_t i : members[gi]) walk_snapped[i] = 1;
       for (SnappedRing& r : sr) {
-        part_src.push_back(parts_polys.size());
-        parts_snapped.push_back(1);
-        parts_polys.push_back(std::move(r.polys));
-        parts.push_back(std::move(r.pts));
+        snapped_parts.push_back(std::move(r.pts));
+        snapped_polys.push_back(std::move(r.polys));
       }
     }
-  }
-  for (std::size_t i = 0; i < rings_.size(); ++i) {
-    if (any_rounded && group_snapped[group[i]]) continue;
-    split_simple(rings_[i].pts, parts);
-    parts_polys.push_back(rings_[i].polys);
-    part_src.resize(parts.size(), parts_polys.size() - 1);
-    parts_snapped.resize(parts.size(), 0);
+    std::vector<std::vector<Point2>> kept;
+    for (std::size_t i = 0; i < rings_.size(); ++i) {
+      if (walk_snapped[i]) continue;
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) {
+        kept.push_back(std::move(parts[k]));
+        part_src.push_back(parts_polys.size());
+        parts_snapped.push_back(0);
+      }
+      parts_polys.push_back(rings_[i].polys);
+    }
+    for (std::size_t k = 0; k < snapped_parts.size(); ++k) {
+      kept.push_back(std::move(snapped_parts[k]));
+      part_src.push_back(parts_polys.size());
+      parts_snapped.push_back(1);
+      parts_polys.push_back(std::move(snapped_polys[k]));
+    }
+    parts.swap(kept);
+  } else {
+    for (std::size_t i = 0; i < rings_.size(); ++i) {
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) {
+        part_src.push_back(parts_polys.size());
+        parts_snapped.push_back(0);
+      }
+      parts_polys.push_back(rings_[i].polys);
+    }
   }
   std::vector<R> outers, holes;
   for (std::size_t i = 0; i < parts.size(); ++i) {

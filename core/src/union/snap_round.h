@@ -42,7 +42,7 @@ std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, d
 bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near);
 
 /// Whether a valid group whose vertices merely near-touch is snap-rounded too. Off: snapping those
-/// closes gaps and necks narrower than a pitch, which changes plan counts against GEOS (3 of 1000
+/// closes gaps and necks narrower than a pitch, which changes plan counts against GEOS (at least 3
 /// cases of the large_offsets property family); the near-touch artefacts stay there (issue 20, open).
 constexpr bool kSnapNearTouch = false;
 
