@@ -122,7 +122,13 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
     first_part[i + 1] = parts.size();
   }
   std::vector<char> walk_snapped(rings_.size(), 0);
-  if (any_rounded && !clean_as_rounded(parts, pitch, kSnapNearTouch)) {
+  std::vector<char> part_rounded;
+  if (any_rounded) {
+    part_rounded.assign(parts.size(), 0);
+    for (std::size_t i = 0; i < rings_.size(); ++i)
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) part_rounded[k] = rings_[i].rounded;
+  }
+  if (any_rounded && !clean_near_rounded(parts, part_rounded, pitch, kSnapNearTouch)) {
     const std::vector<std::uint32_t> group = proximity_groups(rings_, pitch);
     std::vector<char> has_cross(rings_.size(), 0);
     for (std::size_t i = 0; i < rings_.size(); ++i) has_cross[group[i]] |= rings_[i].rounded;

@@ -515,6 +515,37 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
   return ok;
 }
 
+bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded,
+                        double pitch, bool near) {
+  // only rings that can meet a rounded one: the others are exact and pairwise fine
+  std::vector<Box> rb;
+  Box all;
+  std::vector<Box> box(rings.size());
+  for (std::size_t i = 0; i < rings.size(); ++i) {
+    for (const Point2& p : rings[i]) box[i].add(p);
+    box[i].minx -= pitch;
+    box[i].miny -= pitch;
+    box[i].maxx += pitch;
+    box[i].maxy += pitch;
+    if (rounded[i]) {
+      rb.push_back(box[i]);
+      all.add({box[i].minx, box[i].miny});
+      all.add({box[i].maxx, box[i].maxy});
+    }
+  }
+  if (rb.empty()) return true;
+  Buckets grid;
+  grid.build(rb, all);
+  std::vector<std::vector<Point2>> sel;
+  for (std::size_t i = 0; i < rings.size(); ++i) {
+    bool take = rounded[i] != 0;
+    if (!take)
+      grid.query(box[i], [&](std::uint32_t k) { take = take || box[i].overlaps(rb[k]); });
+    if (take) sel.push_back(rings[i]);
+  }
+  return clean_as_rounded(sel, pitch, near);
+}
+
 double snap_pitch(double max_abs) {
   const double m = std::max(std::fabs(max_abs), 0x1p-150);
   const double ulp = std::nextafter(m, INFINITY) - m;

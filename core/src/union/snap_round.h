@@ -39,6 +39,10 @@ std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, d
 /// clean: no two edges cross or overlap, no ring touches itself, and no vertex is within a pitch of
 /// an edge (or vertex) it is not equal to. Then snap rounding is not needed and would only move them.
 /// With `near` false only validity and disjointness are checked.
+/// clean_near_rounded: the same, on the rings flagged `rounded` and the others whose boxes come within
+/// a pitch of one of them (exact rings cannot conflict with each other).
+bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded,
+                        double pitch, bool near);
 bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near);
 
 /// Whether a valid group whose vertices merely near-touch is snap-rounded too. Off: snapping those
