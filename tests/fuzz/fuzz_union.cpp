@@ -2,9 +2,10 @@
 // The union engine on random polygon sets decoded from the fuzz bytes (issue 8), checked against
 // GEOS UnaryUnion (gis/geosref compare_with_geos):
 //   - always: every footprint a member of a plan or named by a union-stage Problem (nothing lost), no
-//     exception but groundplan::Error; near-touch artefacts (tests/support/near_touch.h) reported;
-//   - on valid input: every plan valid by GEOS, no two plans overlapping (on invalid input still
-//     reported only: union-open/README.md, issue 20);
+//     exception but groundplan::Error;
+//   - for every input, valid or not (issue 20, snap rounding): every plan valid by GEOS, no two plans
+//     overlapping, no ROUNDING_INVALID; near-touching output vertices (tests/support/near_touch.h)
+//     reported, not failed (open: snap_round.h kSnapNearTouch);
 //   - when every input polygon is valid by GEOS: the areas agree within 1e-6 (relative).
 // Polygon and hole counts are reported (stderr, first few), not asserted: on near-degenerate input
 // GEOS itself may be the odd one out (it snaps; we are exact).
@@ -87,23 +88,17 @@ GROUNDPLAN_FUZZ_TARGET(union) {
   for (const Footprint& f : fps)
     for (const Polygon& p : f.polygons) inputs_valid = inputs_valid && polygon_valid_geos(h, p);
   GEOS_finish_r(h);
-  // Overlapping or invalid plans: a failure on valid input. On invalid input (self-crossing rings) still
-  // open (tests/corpus/fuzz-regressions/union-open/README.md), reported until snap rounding is in
-  // (issue 20). Rounding each crossing once closed two of those inputs (now in ../union/, replayed).
-  if (c.overlapping_ours || c.invalid_ours) {
-    const std::string why = c.invalid_ours ? "invalid plan: " + c.first_invalid_reason : "two plans overlap: " + c.summary();
-    if (inputs_valid) groundplan_fuzz_fail("union", why.c_str());
-    static int open_reported = 0;
-    if (open_reported++ < 3)
-      std::fprintf(stderr, "groundplan fuzz union: %s on invalid input (open, see "
-                           "tests/corpus/fuzz-regressions/union-open): %s\n", why.c_str(), c.summary().c_str());
-  }
-  // Near-touch artefacts (two output vertices a few ulps apart, a vertex within rounding of another
-  // edge): still open (union-open/README.md), so reported, not failed, until snap rounding is in.
+  // Invalid or overlapping plans: a failure for every input (issue 20: where rounded output would be
+  // invalid or overlapping, snap rounding makes it valid and disjoint by construction).
+  if (c.invalid_ours) groundplan_fuzz_fail("union", ("invalid plan: " + c.first_invalid_reason).c_str());
+  if (c.overlapping_ours) groundplan_fuzz_fail("union", ("two plans overlap: " + c.summary()).c_str());
+  // Near-touch artefacts of valid output: still open, reported (snap_round.h, kSnapNearTouch).
   const groundplan::testing::NearTouch nt = groundplan::testing::near_touch(plans);
   static int near_reported = 0;
   if (nt.pairs && near_reported++ < 3)
     std::fprintf(stderr, "groundplan fuzz union: near-touch artefact (open, issue 20): %s\n", nt.first.c_str());
+  for (const Problem& p : problems)
+    if (p.code == "ROUNDING_INVALID") groundplan_fuzz_fail("union", ("ROUNDING_INVALID: " + p.reason).c_str());
   const double tol = 1e-6 * std::max(c.area_geos, 1.0);
   if (inputs_valid && std::fabs(c.area_ours - c.area_geos) > tol)
     groundplan_fuzz_fail("union", ("area differs from GEOS on valid input: " + c.summary()).c_str());

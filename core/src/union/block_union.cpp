@@ -39,10 +39,9 @@
 // cost is paid only on edges that are not entirely walked (party walls, overlaps, interior edges);
 // for separate buildings every edge is walked by the first seed and the check is a lookup.
 //
-// Output in doubles (assemble: ring_builder.cpp, output_rounding.cpp). Input vertices are exact; crossing points are rounded. A walk with
-// rounded points is checked exactly on its doubles and repaired by local snap rounding (node_walk),
-// split at revisited points into simple rings (split_simple), rid of collapsed rounding slivers, and
-// each plan is checked again; what cannot be repaired at rounding scale becomes a Problem.
+// Output in doubles (assemble: ring_builder.cpp, snap_round.cpp). Input vertices are exact; crossing
+// points are rounded. A block whose walks have no crossing point is output exactly; otherwise its
+// boundary is snap-rounded on the call's grid (snap_round.h), valid and disjoint by construction.
 #include "union/block_union.h"
 #include "union/block_types.h"
 #include "union/ring_builder.h"
@@ -213,7 +212,8 @@ class BlockEngine {
  public:
   BlockEngine() = default;
   /// Prepares for one block, keeping the capacity of every buffer (one engine per thread).
-  void reset(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members) {
+  void reset(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members, double pitch) {
+    pitch_ = pitch;
     footprints_ = &footprints;
     members_ = &members;
     edges_.clear();
@@ -252,7 +252,7 @@ class BlockEngine {
   void check_edge(std::uint32_t e);
   Parity parity_at_vertex_wedge0(const Point2& p);
   // --- output
-  void assemble(BlockResult& out) { assemble_block(rings_, polys_, edges_, stats_, out); }
+  void assemble(BlockResult& out) { assemble_block(rings_, polys_, edges_, pitch_, stats_, out); }
 
   const std::vector<Footprint>* footprints_ = nullptr;
   const std::vector<std::uint32_t>* members_ = nullptr;
@@ -281,6 +281,7 @@ class BlockEngine {
   std::vector<Ray> chk_rays_, chk_wrays_;
   BlockStats stats_;
   std::size_t step_limit_ = 0;
+  double pitch_ = 0;
 };
 
 // ------------------------------------------------------------------------------------------------
@@ -853,9 +854,10 @@ BlockResult BlockEngine::run() {
 
 }  // namespace
 
-BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members) {
+BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members,
+                        double pitch) {
   thread_local BlockEngine engine;
-  engine.reset(footprints, members);
+  engine.reset(footprints, members, pitch);
   return engine.run();
 }
 

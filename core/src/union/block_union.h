@@ -14,7 +14,8 @@ struct BlockStats {
   std::uint64_t rings_traced = 0;    // closed boundary walks
   std::uint64_t seeds_from_check = 0;// walks started by the completeness check (holes, separate rings)
   std::uint64_t edges_checked = 0;   // input edges the completeness check had to examine exactly
-  std::uint64_t rounding_repairs = 0;// vertices removed because rounding made a sliver invalid
+  std::uint64_t rounding_repairs = 0;// snap rounding: opposite grid edges cancelled (collapsed slivers)
+  std::uint64_t snapped_groups = 0;  // groups of walks snap-rounded (they had a crossing point)
 };
 
 struct BlockResult {
@@ -27,6 +28,9 @@ struct BlockResult {
 /// connected polygon, outer ring counter-clockwise, holes clockwise. Each input polygon counts by
 /// the even-odd rule over its rings (its valid repair, as GEOS MakeValid gives it). Throws
 /// TopologyError if a boundary walk does not close (never expected: every decision is exact).
-BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members);
+/// `pitch`: the snap-rounding grid of the whole call (snap_pitch of its largest coordinate), used
+/// when the block's boundary has crossing points.
+BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members,
+                        double pitch);
 
 }  // namespace groundplan::detail

@@ -19,6 +19,7 @@
 #include "robust/predicates.h"
 #include "union/block_union.h"
 #include "union/input_check.h"
+#include "union/snap_round.h"
 
 namespace groundplan {
 std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footprints, const UnionParams& params,
@@ -37,6 +38,20 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     if (!usable[all.indices[k]]) continue;
     fps.indices.push_back(all.indices[k]);
     fps.boxes.push_back(all.boxes[k]);
+  }
+  // Snap rounding (issue 20): one grid for the whole call, from its largest coordinate magnitude. A
+  // block with crossing points is snap-rounded, its vertices moving by up to g/sqrt(2); boxes grown by
+  // 4g put footprints closer than that into one block, so that blocks stay more than 2g apart and
+  // their roundings never meet.
+  double max_abs = 0;
+  for (const FootprintSet::Box& b : fps.boxes)
+    max_abs = std::max({max_abs, std::fabs(b.minx), std::fabs(b.miny), std::fabs(b.maxx), std::fabs(b.maxy)});
+  const double pitch = detail::snap_pitch(max_abs);
+  for (FootprintSet::Box& b : fps.boxes) {
+    b.minx -= 4 * pitch;
+    b.miny -= 4 * pitch;
+    b.maxx += 4 * pitch;
+    b.maxy += 4 * pitch;
   }
   const PixelGrid grid = make_pixel_grid(fps, params.resolution_m);
   const auto t_blocks = std::chrono::steady_clock::now();  // starting the backend counts: CUDA takes ~0.3 s
@@ -62,7 +77,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   auto one = [&](std::size_t oi) {
     const std::size_t bi = order[oi];
     try {
-      results[bi] = detail::union_block(*src, blocks[bi].footprints);
+      results[bi] = detail::union_block(*src, blocks[bi].footprints, pitch);
     } catch (const TopologyError& e) {
       detail::BlockResult r;
       for (std::uint32_t fi : blocks[bi].footprints)

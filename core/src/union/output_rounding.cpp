@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Output in doubles: the exact checks and local snap-rounding repairs of rounded walks and plans
-// (see the head of block_union.cpp and docs/union_engine.md). Moved out of block_union.cpp.
+// Exact measures and checks of output rings on their doubles: area, orientation, point location,
+// and the validity check that guards snap-rounded plans (snap_round.h does the rounding).
 #include "union/output_rounding.h"
 
 #include <algorithm>
@@ -67,13 +67,6 @@ int point_in_ring(const Point2& p, const std::vector<Point2>& r) {
   return odd ? 1 : -1;
 }
 
-/// Rounding scale around a few points: a few ulps of the largest coordinate.
-double rounding_scale(std::initializer_list<Point2> pts) {
-  double m = 0;
-  for (const Point2& p : pts) m = std::max({m, std::fabs(p.x), std::fabs(p.y)});
-  return 8.0 * std::max(std::nextafter(m, INFINITY) - m, 1e-300);
-}
-
 /// Validity of one plan on its rounded coordinates, exactly (robust predicates on the doubles):
 /// OGC says no two ring edges may cross or overlap, and a ring may not touch itself; rings of one
 /// plan may touch at points. Returns false and the ring/vertex of a conflict if invalid.
@@ -128,117 +121,6 @@ bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) 
         return true;
       }
     }
-  }
-  return false;
-}
-
-/// Removes, near a conflict between rings, the vertex whose triangle with its neighbours is
-/// smallest, provided that triangle is a sliver at rounding scale (its height a few ulps): such
-/// conflicts come from slivers whose exact width is below the rounding error. Returns false if no
-/// vertex qualifies (the caller reports a Problem instead of distorting the plan).
-bool repair_once(std::vector<std::vector<Point2>*>& rings, const Conflict& c) {
-  std::size_t best_r = 0, best_i = 0;
-  long double best = std::numeric_limits<long double>::infinity();
-  auto consider = [&](std::size_t r, std::size_t i) {
-    auto& R = *rings[r];
-    const std::size_t n = R.size();
-    if (n <= 3) return;
-    for (std::size_t d = 0; d < 2; ++d) {
-      const std::size_t k = (i + d) % n;
-      const Point2& a = R[(k + n - 1) % n];
-      const Point2& b = R[k];
-      const Point2& cc = R[(k + 1) % n];
-      const long double area = std::fabs(static_cast<long double>(b.x - a.x) * (cc.y - a.y) -
-                                         static_cast<long double>(b.y - a.y) * (cc.x - a.x));
-      if (area < best) {
-        best = area;
-        best_r = r;
-        best_i = k;
-      }
-    }
-  };
-  consider(c.ring_a, c.edge_a);
-  consider(c.ring_b, c.edge_b);
-  if (!std::isfinite(static_cast<double>(best))) return false;
-  {
-    const auto& R = *rings[best_r];
-    const std::size_t n = R.size();
-    const Point2& a = R[(best_i + n - 1) % n];
-    const Point2& b = R[best_i];
-    const Point2& c2 = R[(best_i + 1) % n];
-    const long double base = std::hypot(static_cast<long double>(c2.x) - a.x, static_cast<long double>(c2.y) - a.y);
-    if (best > base * rounding_scale({a, b, c2})) return false;  // |cross| = base * height
-  }
-  auto& R = *rings[best_r];
-  R.erase(R.begin() + static_cast<std::ptrdiff_t>(best_i));
-  return true;
-}
-
-long double dist_to_segment(const Point2& p, const Point2& a, const Point2& b) {
-  const long double dx = static_cast<long double>(b.x) - a.x, dy = static_cast<long double>(b.y) - a.y;
-  const long double px = static_cast<long double>(p.x) - a.x, py = static_cast<long double>(p.y) - a.y;
-  const long double l2 = dx * dx + dy * dy;
-  long double t = l2 > 0 ? (px * dx + py * dy) / l2 : 0;
-  t = std::clamp(t, 0.0L, 1.0L);
-  const long double ex = px - t * dx, ey = py - t * dy;
-  return std::sqrt(ex * ex + ey * ey);
-}
-
-/// Snap rounding, locally, of one rounded closed walk. The exact walk is a valid boundary; only
-/// rounding its crossing points can make two of its edges cross or a vertex land on another edge.
-/// Each such conflict is resolved by inserting the vertex nearest to the other edge into that edge
-/// (moving the boundary by at most that distance, a few ulps), after which the walk touches itself
-/// there and split_simple cuts it into simple rings. Returns false if a conflict is not at rounding
-/// scale (a bug, reported as a Problem by the caller).
-bool node_walk(std::vector<Point2>& w) {
-  for (int round = 0; round < 256; ++round) {
-    const std::size_t n = w.size();
-    if (n < 4) return true;
-    struct Seg {
-      double minx, maxx, miny, maxy;
-      std::size_t i;
-    };
-    std::vector<Seg> segs(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Point2& a = w[i];
-      const Point2& b = w[(i + 1) % n];
-      segs[i] = {std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), i};
-    }
-    std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.minx < y.minx; });
-    bool found = false;
-    std::size_t ins_edge = 0;
-    Point2 ins_pt;
-    for (std::size_t u = 0; u < n && !found; ++u) {
-      for (std::size_t v = u + 1; v < n && segs[v].minx <= segs[u].maxx && !found; ++v) {
-        const Seg& s = segs[u];
-        const Seg& t = segs[v];
-        if (t.miny > s.maxy || s.miny > t.maxy) continue;
-        if ((s.i + 1) % n == t.i || (t.i + 1) % n == s.i) continue;  // adjacent: spikes go in split_simple
-        const Point2 &p1 = w[s.i], &p2 = w[(s.i + 1) % n], &q1 = w[t.i], &q2 = w[(t.i + 1) % n];
-        const int o1 = orient(p1, p2, q1), o2 = orient(p1, p2, q2), o3 = orient(q1, q2, p1), o4 = orient(q1, q2, p2);
-        auto strictly_inside = [](const Point2& a, const Point2& b, const Point2& x) {
-          return !(x == a) && !(x == b) && std::min(a.x, b.x) <= x.x && x.x <= std::max(a.x, b.x) &&
-                 std::min(a.y, b.y) <= x.y && x.y <= std::max(a.y, b.y);
-        };
-        // a vertex exactly on another edge's interior (also covers collinear overlaps)
-        if (o1 == 0 && strictly_inside(p1, p2, q1)) { found = true; ins_edge = s.i; ins_pt = q1; break; }
-        if (o2 == 0 && strictly_inside(p1, p2, q2)) { found = true; ins_edge = s.i; ins_pt = q2; break; }
-        if (o3 == 0 && strictly_inside(q1, q2, p1)) { found = true; ins_edge = t.i; ins_pt = p1; break; }
-        if (o4 == 0 && strictly_inside(q1, q2, p2)) { found = true; ins_edge = t.i; ins_pt = p2; break; }
-        if (o1 * o2 < 0 && o3 * o4 < 0) {
-          // proper crossing: node the endpoint nearest to the other segment into it
-          const long double d[4] = {dist_to_segment(q1, p1, p2), dist_to_segment(q2, p1, p2),
-                                    dist_to_segment(p1, q1, q2), dist_to_segment(p2, q1, q2)};
-          const int k = static_cast<int>(std::min_element(d, d + 4) - d);
-          if (d[k] > rounding_scale({p1, p2, q1, q2})) return false;
-          found = true;
-          ins_edge = k < 2 ? s.i : t.i;
-          ins_pt = k == 0 ? q1 : k == 1 ? q2 : k == 2 ? p1 : p2;
-        }
-      }
-    }
-    if (!found) return true;
-    w.insert(w.begin() + static_cast<std::ptrdiff_t>(ins_edge + 1), ins_pt);
   }
   return false;
 }

@@ -11,16 +11,17 @@
 
 #include "robust/predicates.h"
 #include "union/output_rounding.h"
+#include "union/snap_round.h"
 
 namespace groundplan::detail {
 
 using robust::orient;
 
-/// Splits a closed walk at repeated (rounded) vertices into simple rings; drops collapsed parts.
-/// `rounded`: the walk has rounded crossing points. Only then can a ring of rounding-scale area be a
-/// collapsed sliver; a ring of exact input vertices is part of the exact union whatever its size
-/// (a 1e-9 m² gap between neighbours one ulp apart is a real hole of the input).
-void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point2>>& out, bool rounded) {
+/// Splits a closed walk at repeated vertices into simple rings, drops spikes a-b-a and straight
+/// vertices. Exact on the doubles: a ring of input vertices is part of the exact union whatever its
+/// size (a 1e-9 m² gap between neighbours one ulp apart is a real hole of the input); snapped rings
+/// have no collapsed parts left (snap_round cancels them).
+void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point2>>& out) {
   std::vector<Point2> pts;
   for (const Point2& p : walk)
     if (pts.empty() || !(pts.back() == p)) pts.push_back(p);
@@ -64,21 +65,6 @@ void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point
       }
       r.swap(k);
     }
-    // a ring whose area is at rounding scale is a collapsed sliver (a gap or overlap between
-    // walls that coincide up to rounding): it has no area to give
-    if (rounded && r.size() >= 3) {
-      long double a2 = 0, per = 0;
-      double scale = 0;
-      for (std::size_t i = 0, n = r.size(); i < n; ++i) {
-        const Point2& a = r[i];
-        const Point2& b = r[(i + 1) % n];
-        a2 += (static_cast<long double>(a.x) - r[0].x) * (static_cast<long double>(b.y) - r[0].y) -
-              (static_cast<long double>(b.x) - r[0].x) * (static_cast<long double>(a.y) - r[0].y);
-        per += std::hypot(static_cast<long double>(b.x) - a.x, static_cast<long double>(b.y) - a.y);
-        scale = std::max(scale, rounding_scale({a}));
-      }
-      if (std::fabs(a2) / 2 <= per * scale) r.clear();
-    }
     if (r.size() >= 3) out.push_back(std::move(r));
   };
   {
@@ -109,32 +95,107 @@ void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point
 }
 
 void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>& polys_,
-                    const std::vector<Edge>& edges_, BlockStats& stats_, BlockResult& out) {
+                    const std::vector<Edge>& edges_, double pitch, BlockStats& stats_, BlockResult& out) {
   struct R {
     std::vector<Point2> pts;
-    std::size_t src;  // index into rings_
+    std::size_t src;  // index into parts_polys
     Box box;
     long double area2;
+    bool snapped;
   };
-  std::vector<R> outers, holes;
+  // Simple rings with the polygons bordering them. Walks that are all exact (every vertex an input
+  // vertex) are the exact boundary: split at revisited vertices and kept bit for bit. A group of
+  // nearby walks with a rounded crossing point is snap-rounded as a whole (snap_round.h).
+  std::vector<std::vector<Point2>> parts;
+  std::vector<std::vector<std::uint32_t>> parts_polys;
+  std::vector<std::size_t> part_src;  // parts[k] has the polygons parts_polys[part_src[k]]
+  std::vector<char> parts_snapped;    // parts[k] comes from snap rounding
+  // Walks split as they are (crossings correctly rounded). Exact walks are the exact boundary. If some
+  // walk has a rounded crossing and the whole block's rings are not clean (clean_as_rounded: valid and
+  // disjoint), the walks are grouped by proximity (groups more than 4 pitches apart are independent)
+  // and each group with a crossing whose rings are not clean is snap-rounded; the others stay as split.
+  bool any_rounded = false;
+  for (const RingOut& r : rings_) any_rounded |= r.rounded;
+  std::vector<std::size_t> first_part(rings_.size() + 1, 0);
   for (std::size_t i = 0; i < rings_.size(); ++i) {
-    std::vector<std::vector<Point2>> parts;
-    std::vector<Point2> w;
-    for (const Point2& p : rings_[i].pts)
-      if (w.empty() || !(w.back() == p)) w.push_back(p);
-    while (w.size() > 1 && w.front() == w.back()) w.pop_back();
-    if (rings_[i].rounded && !node_walk(w))
-      out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
-                                     "a boundary crosses itself after rounding by more than rounding error"});
-    split_simple(w, parts, rings_[i].rounded);
-    for (auto& p : parts) {
-      const int o = ring_orientation(p);
-      if (o == 0) continue;
-      R r{std::move(p), i, Box{}, 0};
-      for (const Point2& q : r.pts) r.box.add(q);
-      r.area2 = signed_area2(r.pts);
-      (o > 0 ? outers : holes).push_back(std::move(r));
+    split_simple(rings_[i].pts, parts);
+    first_part[i + 1] = parts.size();
+  }
+  std::vector<char> walk_snapped(rings_.size(), 0);
+  std::vector<char> part_rounded;
+  if (any_rounded) {
+    part_rounded.assign(parts.size(), 0);
+    for (std::size_t i = 0; i < rings_.size(); ++i)
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) part_rounded[k] = rings_[i].rounded;
+  }
+  if (any_rounded && !clean_near_rounded(parts, part_rounded, pitch, kSnapNearTouch)) {
+    const std::vector<std::uint32_t> group = proximity_groups(rings_, pitch);
+    std::vector<char> has_cross(rings_.size(), 0);
+    for (std::size_t i = 0; i < rings_.size(); ++i) has_cross[group[i]] |= rings_[i].rounded;
+    std::vector<std::vector<std::uint32_t>> members(rings_.size());
+    for (std::uint32_t i = 0; i < rings_.size(); ++i)
+      if (has_cross[group[i]]) members[group[i]].push_back(i);
+    std::vector<std::vector<Point2>> snapped_parts;
+    std::vector<std::vector<std::uint32_t>> snapped_polys;
+    for (std::uint32_t gi = 0; gi < rings_.size(); ++gi) {
+      if (members[gi].empty()) continue;
+      std::vector<std::vector<Point2>> as_is;
+      for (std::uint32_t i : members[gi])
+        for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) as_is.push_back(parts[k]);
+      if (members[gi].size() < rings_.size() && clean_as_rounded(as_is, pitch, kSnapNearTouch)) continue;
+      std::vector<RingOut> sub;
+      for (std::uint32_t i : members[gi]) sub.push_back(rings_[i]);
+      std::vector<SnappedRing> sr;
+      SnapStats ss;
+      if (!snap_round(sub, pitch, sr, ss)) {
+        out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                       "snap rounding of a boundary did not give a consistent edge graph; "
+                                       "its crossing points are rounded to nearest instead"});
+        continue;
+      }
+      stats_.snapped_groups += 1;
+      stats_.rounding_repairs += ss.cancelled;
+      for (std::uint32_t i : members[gi]) walk_snapped[i] = 1;
+      for (SnappedRing& r : sr) {
+        snapped_parts.push_back(std::move(r.pts));
+        snapped_polys.push_back(std::move(r.polys));
+      }
     }
+    std::vector<std::vector<Point2>> kept;
+    for (std::size_t i = 0; i < rings_.size(); ++i) {
+      if (walk_snapped[i]) continue;
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) {
+        kept.push_back(std::move(parts[k]));
+        part_src.push_back(parts_polys.size());
+        parts_snapped.push_back(0);
+      }
+      parts_polys.push_back(rings_[i].polys);
+    }
+    for (std::size_t k = 0; k < snapped_parts.size(); ++k) {
+      kept.push_back(std::move(snapped_parts[k]));
+      part_src.push_back(parts_polys.size());
+      parts_snapped.push_back(1);
+      parts_polys.push_back(std::move(snapped_polys[k]));
+    }
+    parts.swap(kept);
+  } else {
+    for (std::size_t i = 0; i < rings_.size(); ++i) {
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) {
+        part_src.push_back(parts_polys.size());
+        parts_snapped.push_back(0);
+      }
+      parts_polys.push_back(rings_[i].polys);
+    }
+  }
+  std::vector<R> outers, holes;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    auto& p = parts[i];
+    const int o = ring_orientation(p);
+    if (o == 0) continue;
+    R r{std::move(p), part_src[i], Box{}, 0, parts_snapped[i] != 0};
+    for (const Point2& q : r.pts) r.box.add(q);
+    r.area2 = signed_area2(r.pts);
+    (o > 0 ? outers : holes).push_back(std::move(r));
   }
   // innermost outer ring containing p (by a vertex not on its boundary)
   auto locate = [&](const std::vector<Point2>& pts, std::size_t skip_outer) -> std::size_t {
@@ -169,7 +230,7 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
   std::vector<char> poly_seen(polys_.size(), 0);
   for (std::size_t k = 0; k < outers.size(); ++k) {
     auto add = [&](std::size_t src) {
-      for (std::uint32_t p : rings_[src].polys) {
+      for (std::uint32_t p : parts_polys[src]) {
         polys_of[k].push_back(p);
         poly_seen[p] = 1;
       }
@@ -198,29 +259,19 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
       a2 += holes[h].area2;
       g.polygon.holes.push_back(std::move(holes[h].pts));
     }
-    // Rounded output must stay valid (issue 3): check exactly, repair rounding slivers locally.
-    // A plan whose vertices are all input vertices is the exact boundary: nothing to check.
-    bool rounded = rings_[outers[k].src].rounded;
-    for (std::size_t h : holes_of[k]) rounded |= rings_[holes[h].src].rounded;
-    if (rounded) {
+    // Snapped plans are valid by construction (docs/union_engine.md); checked exactly all the same,
+    // as the last resort: a conflict would be a bug, reported, never repaired by distorting the plan.
+    bool snapped = outers[k].snapped;
+    for (std::size_t h : holes_of[k]) snapped |= holes[h].snapped;
+    if (snapped) {
       std::vector<std::vector<Point2>*> rr{&g.polygon.outer};
       for (Ring& h : g.polygon.holes) rr.push_back(&h);
       Conflict c{};
-      int repairs = 0;
-      while (find_conflict(rr, c)) {
-        if (repairs >= 32 || !repair_once(rr, c)) {
-          const Point2& p = (*rr[c.ring_a])[c.edge_a % rr[c.ring_a]->size()];
-          out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
-                                         "rounding intersection points to doubles left a self-intersection near (" +
-                                             std::to_string(p.x) + ", " + std::to_string(p.y) + ")"});
-          break;
-        }
-        ++repairs;
-        ++stats_.rounding_repairs;
-      }
-      if (repairs > 0) {
-        a2 = signed_area2(g.polygon.outer);
-        for (const Ring& h : g.polygon.holes) a2 += signed_area2(h);
+      if (find_conflict(rr, c)) {
+        const Point2& p = (*rr[c.ring_a])[c.edge_a % rr[c.ring_a]->size()];
+        out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                       "a snap-rounded plan crosses itself near (" + std::to_string(p.x) + ", " +
+                                           std::to_string(p.y) + ") (a groundplan bug; please report)"});
       }
     }
     g.area_m2 = static_cast<double>(a2 / 2);

@@ -9,12 +9,14 @@
 
 namespace groundplan::detail {
 
-/// Splits a closed walk at repeated (rounded) vertices into simple rings; drops collapsed parts.
-void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point2>>& out, bool rounded);
+/// Splits a closed walk at repeated vertices into simple rings; drops spikes and straight vertices.
+void split_simple(const std::vector<Point2>& walk, std::vector<std::vector<Point2>>& out);
 
-/// The plans of one block from its closed walks: node and split each walk, orient the rings, put
-/// each hole into the innermost outer ring containing it, find the members, check the rounded plans.
+/// The plans of one block from its closed walks: exact walks split into simple rings, or, where a walk
+/// has a rounded crossing point, the whole block snap-rounded on the grid of pitch `pitch`
+/// (snap_round.h); then the rings are oriented, each hole put into the innermost outer ring
+/// containing it, and the members found.
 void assemble_block(const std::vector<RingOut>& rings, const std::vector<Poly>& polys,
-                    const std::vector<Edge>& edges, BlockStats& stats, BlockResult& out);
+                    const std::vector<Edge>& edges, double pitch, BlockStats& stats, BlockResult& out);
 
 }  // namespace groundplan::detail

@@ -1,0 +1,562 @@
+// SPDX-License-Identifier: MIT
+// Snap rounding of one block's boundary (see snap_round.h and docs/union_engine.md).
+//
+// Pixels are half-open squares [i g, (i+1) g) x [j g, (j+1) g) of the grid of pitch g (a power of
+// two); a pixel is hot when it holds a vertex of a walk or a crossing of two walk segments (rounded
+// walks can cross where the exact ones only touch). Every segment is replaced by the polyline through
+// the centres of the hot pixels it meets, in order along it; each piece of that polyline is rerouted
+// again while it meets a hot pixel other than its two ends (iterated snap rounding), so that no
+// output vertex is closer than g/2 to an output edge it is not on. All tests are exact: a segment
+// meets a half-open pixel iff it meets the closed pixel shifted by (-eps, -eps) (separating axes:
+// x, y and the segment's normal; robust::orient on doubles, the symbolic shift breaking ties).
+// Output vertices are pixel centres, kept as integer pixel coordinates, so angles between grid
+// edges are compared in exact integer arithmetic.
+#include "union/snap_round.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <unordered_map>
+
+#include "robust/predicates.h"
+#include "union/output_rounding.h"
+#include "union/ring_builder.h"
+
+namespace groundplan::detail {
+namespace {
+
+/// Distance from p to the closed segment ab (long double: only compared with g/2, far above its error).
+long double dist_to_segment(const Point2& p, const Point2& a, const Point2& b) {
+  const long double dx = static_cast<long double>(b.x) - a.x, dy = static_cast<long double>(b.y) - a.y;
+  const long double px = static_cast<long double>(p.x) - a.x, py = static_cast<long double>(p.y) - a.y;
+  const long double l2 = dx * dx + dy * dy;
+  long double t = l2 > 0 ? (px * dx + py * dy) / l2 : 0;
+  t = std::clamp(t, 0.0L, 1.0L);
+  const long double ex = px - t * dx, ey = py - t * dy;
+  return std::sqrt(ex * ex + ey * ey);
+}
+
+using robust::cross_sign;
+using robust::orient;
+
+struct Pix {
+  std::int64_t i, j;
+  bool operator==(const Pix& o) const { return i == o.i && j == o.j; }
+};
+struct PixHash {
+  std::size_t operator()(const Pix& p) const {
+    return std::hash<std::uint64_t>()(static_cast<std::uint64_t>(p.i) * 0x9E3779B97F4A7C15ull ^
+                                      static_cast<std::uint64_t>(p.j));
+  }
+};
+
+/// Uniform buckets of points or boxes (cell indices monotone in the coordinates) for candidate queries.
+class Buckets {
+ public:
+  void build(const std::vector<Box>& boxes, const Box& all) {
+    ox_ = all.minx;
+    oy_ = all.miny;
+    const double w = std::max(all.maxx - all.minx, 0.0), h = std::max(all.maxy - all.miny, 0.0);
+    const double n = static_cast<double>(std::max<std::size_t>(boxes.size(), 1));
+    double cell = std::sqrt(w * h / n);
+    if (!(cell > 0) || !std::isfinite(cell)) cell = std::max({w, h, 1e-300});
+    nx_ = static_cast<int>(std::clamp(std::ceil(w / cell), 1.0, 1024.0));
+    ny_ = static_cast<int>(std::clamp(std::ceil(h / cell), 1.0, 1024.0));
+    ix_ = w > 0 ? nx_ / w : 0;
+    iy_ = h > 0 ? ny_ / h : 0;
+    start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+    for (const Box& b : boxes) cells(b, [&](std::size_t k) { ++start_[k + 1]; });
+    for (std::size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
+    items_.resize(start_.back());
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::uint32_t i = 0; i < boxes.size(); ++i) cells(boxes[i], [&](std::size_t k) { items_[fill[k]++] = i; });
+    stamp_.assign(boxes.size(), 0);
+    epoch_ = 0;
+  }
+  template <class F>
+  void query(const Box& b, F&& f) {
+    if (++epoch_ == 0) {
+      std::fill(stamp_.begin(), stamp_.end(), 0);
+      epoch_ = 1;
+    }
+    cells(b, [&](std::size_t k) {
+      for (std::uint32_t i = start_[k]; i < start_[k + 1]; ++i) {
+        const std::uint32_t it = items_[i];
+        if (stamp_[it] != epoch_) {
+          stamp_[it] = epoch_;
+          f(it);
+        }
+      }
+    });
+  }
+
+ private:
+  int cx(double x) const { return std::clamp(static_cast<int>(std::floor((x - ox_) * ix_)), 0, nx_ - 1); }
+  int cy(double y) const { return std::clamp(static_cast<int>(std::floor((y - oy_) * iy_)), 0, ny_ - 1); }
+  template <class F>
+  void cells(const Box& b, F&& f) const {
+    const int x0 = cx(b.minx), x1 = cx(b.maxx), y0 = cy(b.miny), y1 = cy(b.maxy);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) f(static_cast<std::size_t>(y) * nx_ + x);
+  }
+  double ox_ = 0, oy_ = 0, ix_ = 0, iy_ = 0;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::uint32_t> start_, items_, stamp_;
+  std::uint32_t epoch_ = 0;
+};
+
+class SnapRounder {
+ public:
+  explicit SnapRounder(double g) : g_(g) {}
+
+  Pix pixel_of(const Point2& p) const {
+    return {static_cast<std::int64_t>(std::floor(p.x / g_)), static_cast<std::int64_t>(std::floor(p.y / g_))};
+  }
+  Point2 centre(std::uint32_t h) const {
+    const Pix& p = hot_[h];
+    return {(static_cast<double>(p.i) + 0.5) * g_, (static_cast<double>(p.j) + 0.5) * g_};
+  }
+  void add_hot(const Pix& p) {
+    if (index_.emplace(p, static_cast<std::uint32_t>(hot_.size())).second) hot_.push_back(p);
+  }
+  /// The hot pixels of a crossing point rounded to nearest: the exact point is within half an ulp,
+  /// so its pixel is that of the rounded point or of a neighbouring double (more hot pixels than
+  /// needed is harmless; fewer would not be).
+  void add_hot_near(const Point2& p) {
+    const double xs[3] = {std::nextafter(p.x, -INFINITY), p.x, std::nextafter(p.x, INFINITY)};
+    const double ys[3] = {std::nextafter(p.y, -INFINITY), p.y, std::nextafter(p.y, INFINITY)};
+    for (double x : xs)
+      for (double y : ys) add_hot(pixel_of({x, y}));
+  }
+
+  /// Exact: does segment ab meet the half-open pixel p?
+  bool meets(const Point2& a, const Point2& b, const Pix& p) const {
+    const double x0 = static_cast<double>(p.i) * g_, x1 = static_cast<double>(p.i + 1) * g_;
+    const double y0 = static_cast<double>(p.j) * g_, y1 = static_cast<double>(p.j + 1) * g_;
+    if (std::max(a.x, b.x) < x0 || std::min(a.x, b.x) >= x1 || std::max(a.y, b.y) < y0 || std::min(a.y, b.y) >= y1)
+      return false;
+    // corners shifted by (-eps, -eps): where a corner is on the line, the side is -sign((b-a) x (1,1))
+    const int tie = -cross_sign(a, b, Point2{0, 0}, Point2{1, 1});
+    bool pos = false, neg = false;
+    const Point2 corners[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    for (const Point2& c : corners) {
+      int s = orient(a, b, c);
+      if (s == 0) s = tie;
+      pos |= s > 0;
+      neg |= s < 0;
+    }
+    return pos && neg;
+  }
+
+  /// The hot pixels segment ab meets, ordered along a->b.
+  void route(const Point2& a, const Point2& b, std::vector<std::uint32_t>& out) {
+    out.clear();
+    Box q;
+    q.add(a);
+    q.add(b);
+    q.minx -= g_;
+    q.miny -= g_;
+    q.maxx += g_;
+    q.maxy += g_;
+    hot_grid_.query(q, [&](std::uint32_t h) {
+      if (meets(a, b, hot_[h])) out.push_back(h);
+    });
+    // along a monotone segment the pixels met form a staircase: sx*i + sy*j increases strictly
+    const std::int64_t sx = sgn_diff(b.x, a.x), sy = sgn_diff(b.y, a.y);
+    std::sort(out.begin(), out.end(), [&](std::uint32_t u, std::uint32_t v) {
+      return sx * hot_[u].i + sy * hot_[u].j < sx * hot_[v].i + sy * hot_[v].j;
+    });
+  }
+
+  bool run(const std::vector<RingOut>& walks, std::vector<SnappedRing>& out, SnapStats& stats);
+
+ private:
+  struct Seg {
+    Point2 a, b;
+    std::uint32_t walk;
+  };
+  struct GEdge {
+    std::uint32_t u, v, walk;
+  };
+  double g_;
+  std::vector<Pix> hot_;
+  std::unordered_map<Pix, std::uint32_t, PixHash> index_;
+  Buckets hot_grid_;
+};
+
+bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing>& out, SnapStats& stats) {
+  // 1. segments of the walks; their vertices make hot pixels
+  std::vector<Seg> segs;
+  Box all;
+  for (std::uint32_t w = 0; w < walks.size(); ++w) {
+    std::vector<Point2> pts;
+    for (const Point2& p : walks[w].pts)
+      if (pts.empty() || !(pts.back() == p)) pts.push_back(p);
+    while (pts.size() > 1 && pts.front() == pts.back()) pts.pop_back();
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      add_hot(pixel_of(pts[k]));
+      all.add(pts[k]);
+      if (pts.size() > 1) segs.push_back({pts[k], pts[(k + 1) % pts.size()], w});
+    }
+  }
+  if (segs.empty()) return true;
+  // 2. crossings of rounded segments make hot pixels (exact orientation; the point correctly rounded)
+  {
+    std::vector<Box> boxes(segs.size());
+    for (std::size_t s = 0; s < segs.size(); ++s) {
+      boxes[s].add(segs[s].a);
+      boxes[s].add(segs[s].b);
+    }
+    Buckets sg;
+    sg.build(boxes, all);
+    for (std::uint32_t s = 0; s < segs.size(); ++s) {
+      const Seg& S = segs[s];
+      sg.query(boxes[s], [&](std::uint32_t t) {
+        if (t <= s || !boxes[s].overlaps(boxes[t])) return;
+        const Seg& T = segs[t];
+        const int o1 = orient(S.a, S.b, T.a), o2 = orient(S.a, S.b, T.b);
+        if (o1 * o2 >= 0) return;
+        const int o3 = orient(T.a, T.b, S.a), o4 = orient(T.a, T.b, S.b);
+        if (o3 * o4 >= 0) return;
+        add_hot_near(robust::crossing_point(S.a, S.b, T.a, T.b));
+      });
+    }
+  }
+  stats.hot_pixels += hot_.size();
+  {
+    std::vector<Box> pb(hot_.size());
+    Box hall;
+    for (std::uint32_t h = 0; h < hot_.size(); ++h) {
+      pb[h].add(centre(h));
+      hall.add(centre(h));
+    }
+    hot_grid_.build(pb, hall);
+  }
+  // 3. iterated snap rounding: each segment through the centres of the hot pixels it meets, each
+  // piece again until no piece meets a hot pixel other than its ends
+  std::vector<GEdge> gedges;
+  std::vector<std::uint32_t> path, sub;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack;
+  std::size_t budget = 64 * segs.size() + 100000;
+  for (const Seg& S : segs) {
+    route(S.a, S.b, path);
+    for (std::size_t k = 0; k + 1 < path.size(); ++k) stack.emplace_back(path[k], path[k + 1]);
+    while (!stack.empty()) {
+      if (budget-- == 0) return false;
+      const auto [u, v] = stack.back();
+      stack.pop_back();
+      route(centre(u), centre(v), sub);
+      if (sub.size() <= 2) {
+        gedges.push_back({u, v, S.walk});
+        continue;
+      }
+      for (std::size_t k = 0; k + 1 < sub.size(); ++k) stack.emplace_back(sub[k], sub[k + 1]);
+    }
+  }
+  // 4. cancellation: opposite coincident grid edges are a collapsed sliver (of union or exterior)
+  std::sort(gedges.begin(), gedges.end(), [](const GEdge& x, const GEdge& y) {
+    const auto kx = std::minmax(x.u, x.v), ky = std::minmax(y.u, y.v);
+    return kx < ky || (kx == ky && x.walk < y.walk);
+  });
+  std::vector<GEdge> kept;
+  std::vector<std::vector<std::uint32_t>> kept_walks;
+  for (std::size_t i = 0; i < gedges.size();) {
+    const auto key = std::minmax(gedges[i].u, gedges[i].v);
+    std::size_t j = i;
+    int net = 0;
+    std::vector<std::uint32_t> ws;
+    for (; j < gedges.size() && std::minmax(gedges[j].u, gedges[j].v) == key; ++j) {
+      net += gedges[j].u < gedges[j].v ? 1 : -1;
+      if (ws.empty() || ws.back() != gedges[j].walk) ws.push_back(gedges[j].walk);
+    }
+    if (net > 1 || net < -1) return false;  // two faces on one side of an edge: cannot happen
+    stats.cancelled += (j - i - static_cast<std::size_t>(net != 0)) / 2;
+    if (net != 0) {
+      kept.push_back(net > 0 ? GEdge{key.first, key.second, 0} : GEdge{key.second, key.first, 0});
+      kept_walks.push_back(std::move(ws));
+    }
+    i = j;
+  }
+  // 5. rings: at each vertex the incoming edge continues with the outgoing edge first clockwise
+  // from its reverse (the engine's rule: minimal rings, pinches come out in OGC form)
+  const std::size_t ne = kept.size();
+  std::vector<std::uint32_t> ostart(hot_.size() + 1, 0), outs(ne);
+  for (const GEdge& e : kept) ++ostart[e.u + 1];
+  for (std::size_t k = 1; k < ostart.size(); ++k) ostart[k] += ostart[k - 1];
+  {
+    std::vector<std::uint32_t> fill(ostart.begin(), ostart.end() - 1);
+    for (std::uint32_t e = 0; e < ne; ++e) outs[fill[kept[e].u]++] = e;
+  }
+  auto dir = [&](std::uint32_t from, std::uint32_t to) {
+    return std::pair<std::int64_t, std::int64_t>{hot_[to].i - hot_[from].i, hot_[to].j - hot_[from].j};
+  };
+  auto half = [](const std::pair<std::int64_t, std::int64_t>& d) { return d.second > 0 || (d.second == 0 && d.first > 0) ? 0 : 1; };
+  auto ccw_less = [&](const std::pair<std::int64_t, std::int64_t>& a, const std::pair<std::int64_t, std::int64_t>& b) {
+    const int ha = half(a), hb = half(b);
+    if (ha != hb) return ha < hb;
+    return static_cast<__int128>(a.first) * b.second - static_cast<__int128>(a.second) * b.first > 0;
+  };
+  std::vector<std::uint32_t> next(ne), chosen(ne, 0);
+  for (std::uint32_t e = 0; e < ne; ++e) {
+    const std::uint32_t v = kept[e].v;
+    const auto r = dir(v, kept[e].u);
+    std::uint32_t best = std::numeric_limits<std::uint32_t>::max(), top = best;
+    for (std::uint32_t k = ostart[v]; k < ostart[v + 1]; ++k) {
+      const std::uint32_t o = outs[k];
+      const auto d = dir(v, kept[o].v);
+      if (top == std::numeric_limits<std::uint32_t>::max() || ccw_less(dir(v, kept[top].v), d)) top = o;
+      if (ccw_less(d, r) && (best == std::numeric_limits<std::uint32_t>::max() || ccw_less(dir(v, kept[best].v), d)))
+        best = o;
+    }
+    if (best == std::numeric_limits<std::uint32_t>::max()) best = top;
+    if (best == std::numeric_limits<std::uint32_t>::max() || chosen[best]++) return false;
+    next[e] = best;
+  }
+  // 6. Exact by default: a hot pixel holding one walk vertex (an input vertex, or a crossing correctly
+  // rounded) and nothing else near it (no other hot pixel in its 5x5 neighbourhood, no other grid edge
+  // meeting its 3x3 neighbourhood) keeps that vertex instead of its centre. Checked exactly afterwards (no crossing, no vertex within g/2 of an
+  // edge it is not on); if that fails, every vertex goes to its centre (plain ISR, valid by construction).
+  std::vector<Point2> rep(hot_.size());
+  std::vector<std::uint8_t> state(hot_.size(), 0);  // 0 no walk vertex, 1 one walk vertex, 2 more
+  for (const RingOut& w : walks)
+    for (std::size_t k = 0; k < w.pts.size(); ++k) {
+      const std::uint32_t h = index_.at(pixel_of(w.pts[k]));
+      if (state[h] == 0) {
+        state[h] = 1;
+        rep[h] = w.pts[k];
+      } else if (state[h] == 1 && !(rep[h] == w.pts[k])) {
+        state[h] = 2;
+      }
+    }
+  std::vector<char> moved(hot_.size(), 0);
+  bool any_moved = false;
+  {
+    std::vector<Box> eb(ne);
+    Box eall;
+    for (std::uint32_t e = 0; e < ne; ++e) {
+      eb[e].add(centre(kept[e].u));
+      eb[e].add(centre(kept[e].v));
+      eall.add(centre(kept[e].u));
+      eall.add(centre(kept[e].v));
+    }
+    Buckets egrid;
+    if (ne) egrid.build(eb, eall);
+    for (std::uint32_t h = 0; h < hot_.size(); ++h) {
+      if (state[h] != 1 || ostart[h + 1] == ostart[h]) continue;
+      bool alone = true;
+      for (std::int64_t di = -2; di <= 2 && alone; ++di)
+        for (std::int64_t dj = -2; dj <= 2 && alone; ++dj)
+          if ((di || dj) && index_.count(Pix{hot_[h].i + di, hot_[h].j + dj})) alone = false;
+      if (!alone) continue;
+      Box n;
+      n.minx = static_cast<double>(hot_[h].i - 1) * g_;
+      n.maxx = static_cast<double>(hot_[h].i + 2) * g_;
+      n.miny = static_cast<double>(hot_[h].j - 1) * g_;
+      n.maxy = static_cast<double>(hot_[h].j + 2) * g_;
+      egrid.query(n, [&](std::uint32_t e) {
+        if (!alone || kept[e].u == h || kept[e].v == h || !n.overlaps(eb[e])) return;
+        const Point2 a = centre(kept[e].u), b = centre(kept[e].v);
+        const Point2 c[4] = {{n.minx, n.miny}, {n.maxx, n.miny}, {n.maxx, n.maxy}, {n.minx, n.maxy}};
+        int pos = 0, neg = 0, zero = 0;
+        for (const Point2& q : c) {
+          const int o = orient(a, b, q);
+          pos += o > 0;
+          neg += o < 0;
+          zero += o == 0;
+        }
+        // separating axes: the boxes overlap, so the closed box is met unless its corners are all
+        // strictly on one side of the edge's line
+        if (zero > 0 || (pos > 0 && neg > 0)) alone = false;
+      });
+      if (alone) moved[h] = any_moved = 1;
+    }
+  }
+  auto build = [&](bool exact) {
+    out.clear();
+    std::vector<char> used(ne, 0);
+    for (std::uint32_t e0 = 0; e0 < ne; ++e0) {
+      if (used[e0]) continue;
+      std::vector<Point2> ring;
+      std::vector<std::uint32_t> ws;
+      for (std::uint32_t e = e0; !used[e]; e = next[e]) {
+        used[e] = 1;
+        const std::uint32_t u = kept[e].u;
+        ring.push_back(exact && moved[u] ? rep[u] : centre(u));
+        for (std::uint32_t w : kept_walks[e]) ws.push_back(w);
+      }
+      std::sort(ws.begin(), ws.end());
+      ws.erase(std::unique(ws.begin(), ws.end()), ws.end());
+      std::vector<std::uint32_t> polys;
+      for (std::uint32_t w : ws) polys.insert(polys.end(), walks[w].polys.begin(), walks[w].polys.end());
+      std::sort(polys.begin(), polys.end());
+      polys.erase(std::unique(polys.begin(), polys.end()), polys.end());
+      std::vector<std::vector<Point2>> parts;
+      split_simple(ring, parts);
+      for (auto& p : parts) out.push_back(SnappedRing{std::move(p), polys});
+    }
+  };
+  if (any_moved) {
+    build(true);
+    // exact check of the moved geometry: no two edges cross or overlap, no vertex near an edge it is not on
+    bool ok = true;
+    {
+      std::vector<std::vector<Point2>*> rr;
+      for (SnappedRing& r : out) rr.push_back(&r.pts);
+      Conflict c{};
+      ok = !find_conflict(rr, c);
+    }
+    for (std::uint32_t e = 0; e < ne && ok; ++e) {
+      const std::uint32_t u = kept[e].u, v = kept[e].v;
+      if (!moved[u] && !moved[v]) continue;
+      const Point2 a = moved[u] ? rep[u] : centre(u), b = moved[v] ? rep[v] : centre(v);
+      Box q;
+      q.add(a);
+      q.add(b);
+      q.minx -= 2 * g_;
+      q.miny -= 2 * g_;
+      q.maxx += 2 * g_;
+      q.maxy += 2 * g_;
+      hot_grid_.query(q, [&](std::uint32_t w) {
+        if (!ok || w == u || w == v || ostart[w + 1] == ostart[w]) return;
+        const Point2 p = moved[w] ? rep[w] : centre(w);
+        if (dist_to_segment(p, a, b) <= 0.5L * g_) ok = false;
+      });
+    }
+    if (ok) return true;
+    stats.exact_fallbacks += 1;
+  }
+  build(false);
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, double pitch) {
+  std::vector<std::uint32_t> parent(walks.size());
+  for (std::uint32_t w = 0; w < walks.size(); ++w) parent[w] = w;
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::vector<Box> boxes;
+  std::vector<std::uint32_t> owner;
+  Box all;
+  const double d = 4 * pitch;
+  for (std::uint32_t w = 0; w < walks.size(); ++w) {
+    const auto& pts = walks[w].pts;
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      Box b;
+      b.add(pts[k]);
+      b.add(pts[(k + 1) % pts.size()]);
+      b.minx -= d;
+      b.miny -= d;
+      b.maxx += d;
+      b.maxy += d;
+      all.add({b.minx, b.miny});
+      all.add({b.maxx, b.maxy});
+      boxes.push_back(b);
+      owner.push_back(w);
+    }
+  }
+  if (boxes.empty()) return parent;
+  Buckets grid;
+  grid.build(boxes, all);
+  for (std::uint32_t s = 0; s < boxes.size(); ++s) {
+    grid.query(boxes[s], [&](std::uint32_t t) {
+      if (owner[t] == owner[s] || !boxes[s].overlaps(boxes[t])) return;
+      const std::uint32_t a = find(owner[s]), b = find(owner[t]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    });
+  }
+  for (std::uint32_t w = 0; w < walks.size(); ++w) parent[w] = find(w);
+  return parent;
+}
+
+bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near) {
+  {
+    std::vector<std::vector<Point2>*> rr;
+    for (const auto& r : rings) rr.push_back(const_cast<std::vector<Point2>*>(&r));
+    Conflict c{};
+    if (find_conflict(rr, c)) return false;
+  }
+  if (!near) return true;
+  std::vector<Point2> pts;
+  std::vector<Box> pb;
+  Box all;
+  for (const auto& r : rings)
+    for (const Point2& p : r) {
+      pts.push_back(p);
+      Box b;
+      b.add(p);
+      pb.push_back(b);
+      all.add(p);
+    }
+  if (pts.empty()) return true;
+  Buckets grid;
+  grid.build(pb, all);
+  const long double d = pitch;
+  bool ok = true;
+  for (const auto& r : rings)
+    for (std::size_t i = 0; i < r.size() && ok; ++i) {
+      const Point2& a = r[i];
+      const Point2& b = r[(i + 1) % r.size()];
+      Box q;
+      q.add(a);
+      q.add(b);
+      q.minx -= pitch;
+      q.miny -= pitch;
+      q.maxx += pitch;
+      q.maxy += pitch;
+      grid.query(q, [&](std::uint32_t k) {
+        if (ok && !(pts[k] == a) && !(pts[k] == b) && dist_to_segment(pts[k], a, b) <= d) ok = false;
+      });
+    }
+  return ok;
+}
+
+bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded,
+                        double pitch, bool near) {
+  // only rings that can meet a rounded one: the others are exact and pairwise fine
+  std::vector<Box> rb;
+  Box all;
+  std::vector<Box> box(rings.size());
+  for (std::size_t i = 0; i < rings.size(); ++i) {
+    for (const Point2& p : rings[i]) box[i].add(p);
+    box[i].minx -= pitch;
+    box[i].miny -= pitch;
+    box[i].maxx += pitch;
+    box[i].maxy += pitch;
+    if (rounded[i]) {
+      rb.push_back(box[i]);
+      all.add({box[i].minx, box[i].miny});
+      all.add({box[i].maxx, box[i].maxy});
+    }
+  }
+  if (rb.empty()) return true;
+  Buckets grid;
+  grid.build(rb, all);
+  std::vector<std::vector<Point2>> sel;
+  for (std::size_t i = 0; i < rings.size(); ++i) {
+    bool take = rounded[i] != 0;
+    if (!take)
+      grid.query(box[i], [&](std::uint32_t k) { take = take || box[i].overlaps(rb[k]); });
+    if (take) sel.push_back(rings[i]);
+  }
+  return clean_as_rounded(sel, pitch, near);
+}
+
+double snap_pitch(double max_abs) {
+  const double m = std::max(std::fabs(max_abs), 0x1p-150);
+  const double ulp = std::nextafter(m, INFINITY) - m;
+  return 16 * ulp;
+}
+
+bool snap_round(const std::vector<RingOut>& walks, double pitch, std::vector<SnappedRing>& out, SnapStats& stats) {
+  SnapRounder s(pitch);
+  if (s.run(walks, out, stats)) return true;
+  out.clear();
+  return false;
+}
+
+}  // namespace groundplan::detail
