@@ -205,6 +205,13 @@ std::size_t count_holes(const PipelineResult& r) {
   return holes;
 }
 
+/// --stats "spatial_index": the GeoPackage index packed by the CLI (gpkg_rtree.h); one form for the
+/// one-process and the tiled run.
+nlohmann::json spatial_index_json(const groundplan::cli::RtreeBuild& index) {
+  return {{"tables", index.tables},   {"entries", index.entries},   {"read_s", index.read_s}, {"write_s", index.write_s},
+          {"commit_s", index.commit_s}, {"error", index.error}, {"by_gdal", index.by_gdal}};
+}
+
 /// --stats: counts (buildings = footprints + dropped: nothing lost) and per-stage timings. False (said
 /// on stderr) when the file cannot be written.
 /// The level-of-detail settings and what they changed (--stats "level_of_detail").
@@ -292,9 +299,7 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
                   {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole}};
   j["raster_backend"] = result.raster_backend;
   if (index)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
-    j["spatial_index"] = {{"tables", index->tables},     {"entries", index->entries}, {"read_s", index->read_s},
-                          {"write_s", index->write_s},   {"commit_s", index->commit_s}, {"error", index->error},
-                          {"by_gdal", index->by_gdal}};
+    j["spatial_index"] = spatial_index_json(*index);
   if (lod.any()) j["level_of_detail"] = lod_json(lod, result.lod_stats);
   if (verify) j["verify"] = *verify;
   std::ofstream f(path);
@@ -407,8 +412,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std:
                   {"map_s", t.map_s}, {"reduce_s", t.reduce_s}};
     j["raster_backend"] = r.raster_backend;
     if (index)
-      j["spatial_index"] = {{"tables", index->tables}, {"entries", index->entries}, {"error", index->error},
-                            {"by_gdal", index->by_gdal}};
+      j["spatial_index"] = spatial_index_json(*index);
     std::ofstream f(stats_path);
     f << j.dump(2) << '\n';
     if (!f) std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());

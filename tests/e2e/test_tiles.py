@@ -157,3 +157,17 @@ def test_a_bad_tile_is_a_problem_and_the_rest_is_written(tmp_path):
     assert tiled[0] == whole[0]
     assert any(p[2] == "UNREADABLE_FILE" for p in tiled[2]), tiled[2]
     assert tiled[3]["tiles"]["tiles"] == 5
+
+
+def test_tiled_geopackage_stats_have_the_one_process_form(tmp_path):
+    """--stats of a tiled GeoPackage run: the packed spatial index reported with the same fields as in the
+    one-process run (scripts read spatial_index.read_s/write_s/commit_s from both)."""
+    src = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
+    stats = {}
+    for mode in ("off", "on"):
+        s = tmp_path / f"{mode}.json"
+        run([BIN, "-q", "--tiles", mode, "--stats", s, "-f", "GPKG", tmp_path / f"{mode}.gpkg", src])
+        stats[mode] = json.loads(s.read_text())
+    assert "tiles" in stats["on"] and "tiles" not in stats["off"]
+    assert stats["on"]["spatial_index"].keys() == stats["off"]["spatial_index"].keys()
+    assert stats["on"]["spatial_index"]["entries"] == stats["off"]["spatial_index"]["entries"] > 0
