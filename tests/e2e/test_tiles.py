@@ -171,3 +171,16 @@ def test_tiled_geopackage_stats_have_the_one_process_form(tmp_path):
     assert "tiles" in stats["on"] and "tiles" not in stats["off"]
     assert stats["on"]["spatial_index"].keys() == stats["off"]["spatial_index"].keys()
     assert stats["on"]["spatial_index"]["entries"] == stats["off"]["spatial_index"]["entries"] > 0
+
+
+def test_auto_keeps_the_one_process_run_where_memory_is_not_at_stake(tmp_path):
+    """--tiles auto (the default) tiles only where one process would hold over a quarter of the memory: a folder
+    of four tiles gives the one-process output byte for byte, and --stats has no "tiles" section."""
+    src = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
+    out = {}
+    for name, flags in (("auto", []), ("off", ["--tiles", "off"])):
+        s = tmp_path / f"{name}.json"
+        run([BIN, "-q", "--stats", s, *flags, "-f", "CSV", "-lco", "GEOMETRY=AS_WKT", tmp_path / f"{name}.csv", src])
+        out[name] = ((tmp_path / f"{name}.csv").read_bytes(), json.loads(s.read_text()))
+    assert out["auto"][0] == out["off"][0]
+    assert "tiles" not in out["auto"][1]

@@ -3,6 +3,7 @@
 // and their member footprints to a temporary file; once every tile's extent is known, the plans whose box meets
 // no other tile's extent are final, the seams' footprints are united again. docs/ARCHITECTURE.md ("Tiles").
 #include <groundplan/error.h>
+#include <groundplan/gis/reader.h>
 #include <groundplan/gis/tiled.h>
 #include <groundplan/ground_plans.h>
 
@@ -240,11 +241,14 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
 
 }  // namespace
 
-std::uint64_t input_bytes(const std::vector<std::string>& inputs, std::size_t* files) {
+std::uint64_t estimated_footprint_bytes(const std::vector<std::string>& inputs, std::size_t* files) {
   std::vector<Problem> ignored;
   const std::vector<std::string> list = detail::expand_inputs(inputs, ignored);
   if (files) *files = list.size();
-  return detail::total_bytes(list);
+  double estimate = 0;
+  for (const std::string& f : list)
+    estimate += static_cast<double>(detail::total_bytes({f})) * (is_input_name(f) ? 0.15 : 5.0);
+  return static_cast<std::uint64_t>(estimate);
 }
 
 std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, const Progress& progress) {

@@ -4,6 +4,9 @@
 #include "pipeline/tile_extents.h"
 
 #include <groundplan/error.h>
+#include <groundplan/gis/tiled.h>
+
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -78,6 +81,20 @@ TEST(PlanSpill, RoundTripWithAndWithoutPolygons) {
   EXPECT_EQ(t.footprints[0].source_id, "B");
   EXPECT_TRUE(t.footprints[0].polygons.empty());
   EXPECT_THROW(spill.read(spill.size(), true), Error);
+}
+
+// --tiles auto weighs files by what their footprints take in one process: a 2D OGR layer several times its
+// bytes, a city model a fraction of them.
+TEST(TilesAuto, FootprintMemoryIsEstimatedByKindOfFile) {
+  const test::TempDir dir("groundplan_tiles_auto");
+  dir.file("tiles/a.gml", std::string(1000, ' '));
+  dir.file("tiles/b.geojson", std::string(2000, ' '));
+  dir.file("tiles/notes.txt", std::string(5000, ' '));  // not an input: not counted
+  std::size_t files = 0;
+  EXPECT_EQ(estimated_footprint_bytes({(dir.path / "tiles").string()}, &files), 150u + 10000u);
+  EXPECT_EQ(files, 2u);
+  EXPECT_EQ(estimated_footprint_bytes({(dir.path / "tiles" / "a.gml").string()}, &files), 150u);
+  EXPECT_EQ(files, 1u);
 }
 
 }  // namespace

@@ -61,9 +61,13 @@ class TiledResult {
   double extent[4] = {0, 0, 0, 0};  // xmin, ymin, xmax, ymax of all footprints (working CRS)
 };
 
-/// The inputs' files (a folder: its input files, sorted; a zip: its entries) and their total size, without
-/// reading them: lets a caller choose the tiled run for large inputs. Throws InputError as run_pipeline does.
-std::uint64_t input_bytes(const std::vector<std::string>& inputs, std::size_t* files = nullptr);
+/// What one process would hold for the inputs' footprints, estimated from the files' sizes without reading
+/// them: one process keeps every footprint (about 870 B a building, tests/bench/RESULTS.md "Tiles"), which is
+/// some 12 % of the bytes of LoD1 CityGML (less for LoD2, CityJSON, KML), but several times the bytes of a 2D
+/// OGR layer of footprints. Factors: city model files 0.15, other (OGR) files 5. `files`: how many files the
+/// inputs name (a folder: its input files; a zip: its entries). For --tiles auto. Throws InputError as
+/// run_pipeline does.
+std::uint64_t estimated_footprint_bytes(const std::vector<std::string>& inputs, std::size_t* files = nullptr);
 
 /// Runs the pipeline tile by tile (a tile = one input file). Same plans, members, problems and counts as
 /// run_pipeline (as sets; the order is the one TiledResult states). A level of detail is refused
