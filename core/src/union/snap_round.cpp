@@ -12,6 +12,7 @@
 // Output vertices are pixel centres, kept as integer pixel coordinates, so angles between grid
 // edges are compared in exact integer arithmetic.
 #include "union/snap_round.h"
+#include "union/box_grid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -49,61 +50,6 @@ struct PixHash {
     return std::hash<std::uint64_t>()(static_cast<std::uint64_t>(p.i) * 0x9E3779B97F4A7C15ull ^
                                       static_cast<std::uint64_t>(p.j));
   }
-};
-
-/// Uniform buckets of points or boxes (cell indices monotone in the coordinates) for candidate queries.
-class Buckets {
- public:
-  void build(const std::vector<Box>& boxes, const Box& all) {
-    ox_ = all.minx;
-    oy_ = all.miny;
-    const double w = std::max(all.maxx - all.minx, 0.0), h = std::max(all.maxy - all.miny, 0.0);
-    const double n = static_cast<double>(std::max<std::size_t>(boxes.size(), 1));
-    double cell = std::sqrt(w * h / n);
-    if (!(cell > 0) || !std::isfinite(cell)) cell = std::max({w, h, 1e-300});
-    nx_ = static_cast<int>(std::clamp(std::ceil(w / cell), 1.0, 1024.0));
-    ny_ = static_cast<int>(std::clamp(std::ceil(h / cell), 1.0, 1024.0));
-    ix_ = w > 0 ? nx_ / w : 0;
-    iy_ = h > 0 ? ny_ / h : 0;
-    start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
-    for (const Box& b : boxes) cells(b, [&](std::size_t k) { ++start_[k + 1]; });
-    for (std::size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
-    items_.resize(start_.back());
-    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::uint32_t i = 0; i < boxes.size(); ++i) cells(boxes[i], [&](std::size_t k) { items_[fill[k]++] = i; });
-    stamp_.assign(boxes.size(), 0);
-    epoch_ = 0;
-  }
-  template <class F>
-  void query(const Box& b, F&& f) {
-    if (++epoch_ == 0) {
-      std::fill(stamp_.begin(), stamp_.end(), 0);
-      epoch_ = 1;
-    }
-    cells(b, [&](std::size_t k) {
-      for (std::uint32_t i = start_[k]; i < start_[k + 1]; ++i) {
-        const std::uint32_t it = items_[i];
-        if (stamp_[it] != epoch_) {
-          stamp_[it] = epoch_;
-          f(it);
-        }
-      }
-    });
-  }
-
- private:
-  int cx(double x) const { return std::clamp(static_cast<int>(std::floor((x - ox_) * ix_)), 0, nx_ - 1); }
-  int cy(double y) const { return std::clamp(static_cast<int>(std::floor((y - oy_) * iy_)), 0, ny_ - 1); }
-  template <class F>
-  void cells(const Box& b, F&& f) const {
-    const int x0 = cx(b.minx), x1 = cx(b.maxx), y0 = cy(b.miny), y1 = cy(b.maxy);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) f(static_cast<std::size_t>(y) * nx_ + x);
-  }
-  double ox_ = 0, oy_ = 0, ix_ = 0, iy_ = 0;
-  int nx_ = 1, ny_ = 1;
-  std::vector<std::uint32_t> start_, items_, stamp_;
-  std::uint32_t epoch_ = 0;
 };
 
 class SnapRounder {
@@ -182,7 +128,7 @@ class SnapRounder {
   double g_;
   std::vector<Pix> hot_;
   std::unordered_map<Pix, std::uint32_t, PixHash> index_;
-  Buckets hot_grid_;
+  BoxGrid hot_grid_;
 };
 
 bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing>& out, SnapStats& stats) {
@@ -208,8 +154,8 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
       boxes[s].add(segs[s].a);
       boxes[s].add(segs[s].b);
     }
-    Buckets sg;
-    sg.build(boxes, all);
+    BoxGrid sg;
+    sg.build(boxes, all, boxes.size());
     for (std::uint32_t s = 0; s < segs.size(); ++s) {
       const Seg& S = segs[s];
       sg.query(boxes[s], [&](std::uint32_t t) {
@@ -231,7 +177,7 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
       pb[h].add(centre(h));
       hall.add(centre(h));
     }
-    hot_grid_.build(pb, hall);
+    hot_grid_.build(pb, hall, pb.size());
   }
   // 3. iterated snap rounding: each segment through the centres of the hot pixels it meets, each
   // piece again until no piece meets a hot pixel other than its ends
@@ -340,8 +286,8 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
       eall.add(centre(kept[e].u));
       eall.add(centre(kept[e].v));
     }
-    Buckets egrid;
-    if (ne) egrid.build(eb, eall);
+    BoxGrid egrid;
+    if (ne) egrid.build(eb, eall, eb.size());
     for (std::uint32_t h = 0; h < hot_.size(); ++h) {
       if (state[h] != 1 || ostart[h + 1] == ostart[h]) continue;
       bool alone = true;
@@ -460,8 +406,8 @@ std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, d
     }
   }
   if (boxes.empty()) return parent;
-  Buckets grid;
-  grid.build(boxes, all);
+  BoxGrid grid;
+  grid.build(boxes, all, boxes.size());
   for (std::uint32_t s = 0; s < boxes.size(); ++s) {
     grid.query(boxes[s], [&](std::uint32_t t) {
       if (owner[t] == owner[s] || !boxes[s].overlaps(boxes[t])) return;
@@ -493,8 +439,8 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
       all.add(p);
     }
   if (pts.empty()) return true;
-  Buckets grid;
-  grid.build(pb, all);
+  BoxGrid grid;
+  grid.build(pb, all, pb.size());
   const long double d = pitch;
   bool ok = true;
   for (const auto& r : rings)
@@ -534,8 +480,8 @@ bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std
     }
   }
   if (rb.empty()) return true;
-  Buckets grid;
-  grid.build(rb, all);
+  BoxGrid grid;
+  grid.build(rb, all, rb.size());
   std::vector<std::vector<Point2>> sel;
   for (std::size_t i = 0; i < rings.size(); ++i) {
     bool take = rounded[i] != 0;
