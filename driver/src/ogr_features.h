@@ -5,7 +5,13 @@
 
 #include <ogrsf_frmts.h>
 
+#include <memory>
 #include <string>
+#include <vector>
+
+namespace groundplan::driver {
+class OGRGroundPlanLayer;
+}
 
 namespace groundplan::driver::detail {
 
@@ -14,5 +20,8 @@ OGRPolygon* to_ogr_polygon(const Polygon& poly);
 void add_field(OGRFeatureDefn* defn, const char* name, OGRFieldType type, int width = 0);
 /// "a,b,c,d" cut to at most `max` characters at a comma, ending in ",...(+N)" with N ids left out (max 0: whole).
 std::string cut_id_list(const std::string& ids, std::size_t count, std::size_t max);
+/// The "problems" layer (source_id, file, stage, code, reason) over `problems`, which must outlive it (the
+/// dataset holds the result the layer reads).
+std::unique_ptr<OGRGroundPlanLayer> problems_layer(const std::vector<Problem>* problems, int threads);
 
 }  // namespace groundplan::driver::detail

@@ -57,6 +57,24 @@ std::string detail::cut_id_list(const std::string& ids, std::size_t count, std::
   return ids.substr(0, end) + (kept ? "," : "") + "...(+" + std::to_string(count - kept) + ")";
 }
 
+std::unique_ptr<OGRGroundPlanLayer> detail::problems_layer(const std::vector<Problem>* problems, int threads) {
+  auto layer = std::make_unique<OGRGroundPlanLayer>(
+      "problems", wkbNone, nullptr, problems->size(),
+      [problems](OGRFeatureDefn* defn, std::size_t i) {
+        const Problem& p = (*problems)[i];
+        auto* f = new OGRFeature(defn);
+        f->SetField(0, p.source_id.c_str());
+        f->SetField(1, p.file.c_str());
+        f->SetField(2, p.stage.c_str());
+        f->SetField(3, p.code.c_str());
+        f->SetField(4, p.reason.c_str());
+        return f;
+      },
+      OGRGroundPlanLayer::Extent{}, threads);
+  for (const char* name : {"source_id", "file", "stage", "code", "reason"}) add_field(layer->defn(), name, OFTString);
+  return layer;
+}
+
 namespace {
 
 /// The envelope of `rings` (outer rings of plans or footprint polygons).
@@ -180,20 +198,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   add_field(footprints->defn(), "min_z", OFTReal);
   add_field(footprints->defn(), "max_z", OFTReal);
 
-  auto problems = std::make_unique<OGRGroundPlanLayer>(
-      "problems", wkbNone, nullptr, r.problems.size(),
-      [res](OGRFeatureDefn* defn, std::size_t i) {
-        const Problem& p = res->problems[i];
-        auto* f = new OGRFeature(defn);
-        f->SetField(0, p.source_id.c_str());
-        f->SetField(1, p.file.c_str());
-        f->SetField(2, p.stage.c_str());
-        f->SetField(3, p.code.c_str());
-        f->SetField(4, p.reason.c_str());
-        return f;
-      },
-      OGRGroundPlanLayer::Extent{}, threads);
-  for (const char* name : {"source_id", "file", "stage", "code", "reason"}) add_field(problems->defn(), name, OFTString);
+  auto problems = detail::problems_layer(&res->problems, threads);
 
   // One row per (plan, member): the full lists in a form every format holds.
   struct Member {

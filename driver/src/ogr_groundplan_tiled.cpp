@@ -68,20 +68,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   add_field(plans->defn(), "max_z", OFTReal);
   add_field(plans->defn(), dbf ? "bldg_ids" : "building_ids", OFTString);
 
-  auto problems = std::make_unique<OGRGroundPlanLayer>(
-      "problems", wkbNone, nullptr, res->problems.size(),
-      [res](OGRFeatureDefn* defn, std::size_t i) {
-        const Problem& p = res->problems[i];
-        auto* f = new OGRFeature(defn);
-        f->SetField(0, p.source_id.c_str());
-        f->SetField(1, p.file.c_str());
-        f->SetField(2, p.stage.c_str());
-        f->SetField(3, p.code.c_str());
-        f->SetField(4, p.reason.c_str());
-        return f;
-      },
-      OGRGroundPlanLayer::Extent{}, threads);
-  for (const char* name : {"source_id", "file", "stage", "code", "reason"}) add_field(problems->defn(), name, OFTString);
+  auto problems = detail::problems_layer(&res->problems, threads);
 
   // Row r belongs to the plan i with members_before(i) <= r < members_before(i + 1).
   auto members = std::make_unique<OGRGroundPlanLayer>(
