@@ -20,6 +20,12 @@ struct Box {
     maxx = std::max(maxx, p.x);
     maxy = std::max(maxy, p.y);
   }
+  void grow(double d) {  // by d on every side
+    minx -= d;
+    miny -= d;
+    maxx += d;
+    maxy += d;
+  }
   bool overlaps(const Box& o) const { return minx <= o.maxx && o.minx <= maxx && miny <= o.maxy && o.miny <= maxy; }
   bool contains(const Point2& p) const { return minx <= p.x && p.x <= maxx && miny <= p.y && p.y <= maxy; }
 };

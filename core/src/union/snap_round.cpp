@@ -101,10 +101,7 @@ class SnapRounder {
     Box q;
     q.add(a);
     q.add(b);
-    q.minx -= g_;
-    q.miny -= g_;
-    q.maxx += g_;
-    q.maxy += g_;
+    q.grow(g_);
     hot_grid_.query(q, [&](std::uint32_t h) {
       if (meets(a, b, hot_[h])) out.push_back(h);
     });
@@ -359,10 +356,7 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
       Box q;
       q.add(a);
       q.add(b);
-      q.minx -= 2 * g_;
-      q.miny -= 2 * g_;
-      q.maxx += 2 * g_;
-      q.maxy += 2 * g_;
+      q.grow(2 * g_);
       hot_grid_.query(q, [&](std::uint32_t w) {
         if (!ok || w == u || w == v || ostart[w + 1] == ostart[w]) return;
         const Point2 p = moved[w] ? rep[w] : centre(w);
@@ -395,10 +389,7 @@ std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, d
       Box b;
       b.add(pts[k]);
       b.add(pts[(k + 1) % pts.size()]);
-      b.minx -= d;
-      b.miny -= d;
-      b.maxx += d;
-      b.maxy += d;
+      b.grow(d);
       all.add({b.minx, b.miny});
       all.add({b.maxx, b.maxy});
       boxes.push_back(b);
@@ -450,10 +441,7 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
       Box q;
       q.add(a);
       q.add(b);
-      q.minx -= pitch;
-      q.miny -= pitch;
-      q.maxx += pitch;
-      q.maxy += pitch;
+      q.grow(pitch);
       grid.query(q, [&](std::uint32_t k) {
         if (ok && !(pts[k] == a) && !(pts[k] == b) && dist_to_segment(pts[k], a, b) <= d) ok = false;
       });
@@ -469,10 +457,7 @@ bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std
   std::vector<Box> box(rings.size());
   for (std::size_t i = 0; i < rings.size(); ++i) {
     for (const Point2& p : rings[i]) box[i].add(p);
-    box[i].minx -= pitch;
-    box[i].miny -= pitch;
-    box[i].maxx += pitch;
-    box[i].maxy += pitch;
+    box[i].grow(pitch);
     if (rounded[i]) {
       rb.push_back(box[i]);
       all.add({box[i].minx, box[i].miny});
