@@ -13,42 +13,53 @@ DEFAULT = HERE.parents[1] / "sample_data" / "niedersachsen-lorup" / "LoD1_240658
 NUM3 = re.compile(r"(-?\d+(?:\.\d*)?)\s+(-?\d+(?:\.\d*)?)\s+(-?\d+(?:\.\d*)?)")
 
 
+class Template:
+    """A real tile's buildings cut once into the text between coordinate triples and the triples as numbers, so
+    that shifted copies are written without parsing again (also used by gen_tiled_city.py)."""
+
+    def __init__(self, src):
+        text = src.read_text(encoding="utf-8")
+        first = text.index("<core:cityObjectMember>")
+        last = text.rindex("</core:cityObjectMember>") + len("</core:cityObjectMember>")
+        self.head, body, self.tail = text[:first], text[first:last], text[last:]
+        self.members = body.count("<core:cityObjectMember>")
+        xs, ys = [], []
+        self.pieces, self.triples, pos = [], [], 0
+        for m in NUM3.finditer(body):
+            xs.append(float(m.group(1)))
+            ys.append(float(m.group(2)))
+            self.pieces.append(body[pos:m.start()])
+            self.triples.append((float(m.group(1)), float(m.group(2)), m.group(3)))
+            pos = m.end()
+        self.pieces.append(body[pos:])
+        self.width, self.height = max(xs) - min(xs), max(ys) - min(ys)
+
+    def copy(self, ox, oy, id_prefix):
+        """The buildings shifted by (ox, oy), every gml:id prefixed."""
+        parts = []
+        for p, (x, y, z) in zip(self.pieces, self.triples):
+            parts.append(p)
+            parts.append(f"{x + ox:.3f} {y + oy:.3f} {z}")
+        parts.append(self.pieces[-1])
+        return "".join(parts).replace('gml:id="', f'gml:id="{id_prefix}')
+
+
 def main():
     out, size_mb = pathlib.Path(sys.argv[1]), float(sys.argv[2])
     src = pathlib.Path(sys.argv[3]) if len(sys.argv) > 3 else DEFAULT
-    text = src.read_text(encoding="utf-8")
-    first = text.index("<core:cityObjectMember>")
-    last = text.rindex("</core:cityObjectMember>") + len("</core:cityObjectMember>")
-    head, body, tail = text[:first], text[first:last], text[last:]
-    xs, ys = [], []
-    for m in NUM3.finditer(body):
-        xs.append(float(m.group(1)))
-        ys.append(float(m.group(2)))
-    dx, dy = max(xs) - min(xs) + 100.0, max(ys) - min(ys) + 100.0
-    # Pieces: text between coordinate triples, and the triples as numbers (one parse, many copies).
-    pieces, triples, pos = [], [], 0
-    for m in NUM3.finditer(body):
-        pieces.append(body[pos:m.start()])
-        triples.append((float(m.group(1)), float(m.group(2)), m.group(3)))
-        pos = m.end()
-    pieces.append(body[pos:])
+    t = Template(src)
+    dx, dy = t.width + 100.0, t.height + 100.0
     target = int(size_mb * 1e6)
     written, copy = 0, 0
     with out.open("w", encoding="utf-8") as f:
-        f.write(head)
-        written += len(head)
+        f.write(t.head)
+        written += len(t.head)
         while written < target:
-            ox, oy = dx * (copy % 64), dy * (copy // 64)
-            parts = []
-            for p, (x, y, z) in zip(pieces, triples):
-                parts.append(p)
-                parts.append(f"{x + ox:.3f} {y + oy:.3f} {z}")
-            parts.append(pieces[-1])
-            chunk = "".join(parts).replace('gml:id="', f'gml:id="c{copy}_')
+            chunk = t.copy(dx * (copy % 64), dy * (copy // 64), f"c{copy}_")
             f.write(chunk)
             written += len(chunk)
             copy += 1
-        f.write(tail)
+        f.write(t.tail)
     print(f"{out}: {written / 1e6:.0f} MB, {copy} copies of {src.name}")
 
 
