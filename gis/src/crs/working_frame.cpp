@@ -6,9 +6,13 @@
 #include <proj.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <unordered_map>
 
 namespace groundplan::gis {
@@ -41,28 +45,62 @@ int utm_epsg_for(double lon_deg, double lat_deg) {
   return (lat_deg >= 0 ? 32600 : 32700) + zone;
 }
 
+/// A working CRS and the operation from the source into it.
+struct FrameTarget {
+  PjPtr working;
+  PjPtr op;  // null: nothing to transform (a projected metric source, perhaps with swapped axes)
+  WorkingCrs crs;
+};
+
+// A frame's PROJ objects cost ~100M instructions to make (proj_create_crs_to_crs searches proj.db), as
+// much as reading a 3 MB PLATEAU tile; a folder of such tiles paid it once a file. So an Impl outlives
+// its frame: it goes back to a pool under its key (the constructor's arguments) and the next frame with
+// that key takes it, with the operations already made. An Impl (and so its PJ_CONTEXT) belongs to one
+// frame at a time, whichever thread that frame is used on: PROJ's rule (one context per thread at a time)
+// holds without tying frames to threads. The operations are made exactly as a fresh frame makes them, so
+// results do not depend on reuse.
 struct WorkingFrame::Impl {
   PJ_CONTEXT* ctx = nullptr;
+  std::string key;
   SrsName source;
   CrsOptions options;
-  std::string file;
   PjPtr src_h;          // horizontal part of the source CRS
   PJ_TYPE src_type = PJ_TYPE_UNKNOWN;
   bool src_known = false;
   bool src_metric_projected = false;
   bool swap_in = false;  // file writes the other axis order than the CRS's: swap x/y before PROJ
-  PjPtr working;
-  PjPtr op;              // source (as written) -> working (easting, northing)
+  // What the constructor decided, restored for every frame that reuses this Impl:
+  std::vector<std::string> base_notes;
+  bool base_identity = false;
+  bool base_decided = false;
+  FrameTarget base;                  // the target CRS or the metric source itself; empty otherwise
+  // What decide() made, kept for the next frames: the source -> lon/lat operation and one target per UTM zone.
+  PjPtr to_ll;
+  bool to_ll_made = false;
+  std::map<int, FrameTarget> zones;
+
+  // This frame's state.
+  std::string file;
+  std::vector<std::string> notes;
+  const FrameTarget* current = nullptr;  // null: no working CRS yet (or none: source unknown)
   bool identity = false;
   bool decided = false;
-  WorkingCrs crs;
-  std::vector<std::string> notes;
 
   ~Impl() {
-    op.reset();
-    working.reset();
+    zones.clear();
+    to_ll.reset();
+    base = FrameTarget{};
     src_h.reset();
     if (ctx) proj_context_destroy(ctx);
+  }
+
+  /// Per-frame state as the constructor left it.
+  void begin(const std::string& file_name) {
+    file = file_name;
+    notes = base_notes;
+    identity = base_identity;
+    decided = base_decided;
+    current = base.working ? &base : nullptr;
   }
 
   std::string where() const { return file.empty() ? std::string() : file + ": "; }
@@ -93,11 +131,13 @@ struct WorkingFrame::Impl {
     return dir && (std::string(dir) == "north" || std::string(dir) == "south");
   }
 
-  void fill_crs(PJ* p, const std::string& definition) {
-    crs_known_from(p);
-    crs.definition = definition;
+  void fill_crs(FrameTarget& t, const std::string& definition) const {
+    crs_known_from(t);
+    t.crs.definition = definition;
   }
-  void crs_known_from(PJ* p) {
+  void crs_known_from(FrameTarget& t) const {
+    WorkingCrs& crs = t.crs;
+    PJ* p = t.working.get();
     crs.known = true;
     const char* opts[] = {"MULTILINE=NO", nullptr};
     const char* wkt = proj_as_wkt(ctx, p, PJ_WKT2_2019, opts);
@@ -109,22 +149,92 @@ struct WorkingFrame::Impl {
     crs.epsg = auth && code && std::string(auth) == "EPSG" ? std::atoi(code) : 0;
   }
 
-  void make_op() {
+  void make_op(FrameTarget& t) const {
     // Input: as written (authority order for geographic sources, easting first for projected ones;
     // swap_in handles files that say otherwise). Output: normalised, easting first.
     PjPtr src_in(src_type == PJ_TYPE_PROJECTED_CRS ? proj_normalize_for_visualization(ctx, src_h.get())
                                                    : proj_clone(ctx, src_h.get()));
-    PjPtr dst(proj_normalize_for_visualization(ctx, working.get()));
+    PjPtr dst(proj_normalize_for_visualization(ctx, t.working.get()));
     if (!src_in || !dst) throw Error(where() + "PROJ could not normalise the axis order of " + source.text);
-    op.reset(proj_create_crs_to_crs_from_pj(ctx, src_in.get(), dst.get(), nullptr, nullptr));
-    if (!op)
-      throw InputError(where() + "PROJ finds no transformation from " + source.text + " to " + crs.name +
+    t.op.reset(proj_create_crs_to_crs_from_pj(ctx, src_in.get(), dst.get(), nullptr, nullptr));
+    if (!t.op)
+      throw InputError(where() + "PROJ finds no transformation from " + source.text + " to " + t.crs.name +
                        "; name another target with -t_srs");
   }
 };
 
-WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& options, const std::string& file)
-    : impl_(std::make_unique<Impl>()) {
+namespace {
+
+std::string frame_key(const std::string& source_srs, const CrsOptions& o) {
+  return source_srs + '\n' + o.target_srs + '\n' + std::to_string(static_cast<int>(o.source_axis)) +
+         (o.gml_short_epsg_east_first ? "e" : "a");
+}
+
+// Trivially destructible, so still readable after the pool is gone at exit.
+std::atomic<bool> g_pool_closed{false};
+std::atomic<std::size_t> g_setups{0};
+
+/// Impls of finished frames, by key. Bounded: a few per key and thread, few keys.
+struct FramePool {
+  std::mutex mu;
+  std::unordered_map<std::string, std::vector<std::unique_ptr<WorkingFrame::Impl>>> free;
+  std::size_t count = 0;
+  ~FramePool() { g_pool_closed = true; }
+};
+
+std::size_t pool_limit() {
+  static const std::size_t n = std::max<std::size_t>(16, 2 * std::thread::hardware_concurrency());
+  return n;
+}
+
+FramePool& pool() {
+  static FramePool p;
+  return p;
+}
+
+}  // namespace
+
+std::unique_ptr<WorkingFrame::Impl> WorkingFrame::take_pooled(const std::string& key) {
+  if (g_pool_closed) return nullptr;
+  FramePool& p = pool();
+  std::lock_guard<std::mutex> lock(p.mu);
+  auto it = p.free.find(key);
+  if (it == p.free.end() || it->second.empty()) return nullptr;
+  std::unique_ptr<Impl> impl = std::move(it->second.back());
+  it->second.pop_back();
+  --p.count;
+  return impl;
+}
+
+void WorkingFrame::give_back(std::unique_ptr<Impl> impl) {
+  if (!impl || impl->key.empty() || g_pool_closed) return;
+  if (impl->zones.size() > 8) impl->zones.clear();  // a frame that crossed many zones: start again
+  std::unique_ptr<Impl> dropped;  // destroyed outside the lock
+  FramePool& p = pool();
+  std::lock_guard<std::mutex> lock(p.mu);
+  if (p.count >= pool_limit()) {
+    // Full: make room by dropping an Impl of another key (or this one).
+    for (auto it = p.free.begin(); it != p.free.end(); ++it)
+      if (!it->second.empty()) {
+        dropped = std::move(it->second.back());
+        it->second.pop_back();
+        if (it->second.empty()) p.free.erase(it);
+        --p.count;
+        break;
+      }
+  }
+  p.free[impl->key].push_back(std::move(impl));
+  ++p.count;
+}
+
+WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& options, const std::string& file) {
+  std::string key = frame_key(source_srs, options);
+  impl_ = take_pooled(key);
+  if (impl_) {
+    impl_->begin(file);
+    return;
+  }
+  impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
   m.ctx = proj_context_create();
   if (!m.ctx) throw Error("cannot create a PROJ context");
@@ -132,11 +242,12 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
   m.options = options;
   m.file = file;
   m.source = parse_srs_name(source_srs);
+  std::vector<std::string>& notes = m.base_notes;
 
   if (!m.source.local) {
     PjPtr src = m.create(m.source.definition);
     if (!src) {
-      m.notes.push_back("srsName \"" + source_srs + "\" is not a CRS PROJ knows: coordinates kept as written, CRS unknown");
+      notes.push_back("srsName \"" + source_srs + "\" is not a CRS PROJ knows: coordinates kept as written, CRS unknown");
     } else {
       PJ_TYPE t = proj_get_type(src.get());
       if (t == PJ_TYPE_COMPOUND_CRS) {
@@ -151,16 +262,16 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
         m.src_known = true;
         m.src_metric_projected = m.projected_metric(m.src_h.get());
       } else {
-        m.notes.push_back("srsName \"" + source_srs + "\" is neither a projected nor a geographic CRS (" +
-                          (m.src_type == PJ_TYPE_GEOCENTRIC_CRS ? "geocentric" : "other") +
-                          "): coordinates kept as written, CRS unknown");
+        notes.push_back("srsName \"" + source_srs + "\" is neither a projected nor a geographic CRS (" +
+                        (m.src_type == PJ_TYPE_GEOCENTRIC_CRS ? "geocentric" : "other") +
+                        "): coordinates kept as written, CRS unknown");
         m.src_h.reset();
       }
     }
   } else {
-    m.notes.push_back(source_srs.empty()
-                          ? "the file has no srsName: coordinates kept as written, CRS unknown"
-                          : "srsName \"" + source_srs + "\" is a CRS local to the file: coordinates kept as written, CRS unknown");
+    notes.push_back(source_srs.empty()
+                        ? "the file has no srsName: coordinates kept as written, CRS unknown"
+                        : "srsName \"" + source_srs + "\" is a CRS local to the file: coordinates kept as written, CRS unknown");
   }
 
   if (m.src_known) {
@@ -173,9 +284,9 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
       case AxisOrder::Auto:
         m.swap_in = authority_north_first && short_epsg && options.gml_short_epsg_east_first;
         if (m.swap_in)
-          m.notes.push_back("srsName \"" + t + "\" in its short form: read longitude first, as GDAL's GML driver does "
-                            "(the URN/URL forms keep EPSG's latitude first); --axis-order north-east if the file "
-                            "writes latitude first");
+          notes.push_back("srsName \"" + t + "\" in its short form: read longitude first, as GDAL's GML driver does "
+                          "(the URN/URL forms keep EPSG's latitude first); --axis-order north-east if the file "
+                          "writes latitude first");
         break;
       case AxisOrder::EastNorth: m.swap_in = authority_north_first; break;
       case AxisOrder::NorthEast: m.swap_in = !authority_north_first && is_geographic(m.src_type); break;
@@ -183,47 +294,61 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
     if (options.source_axis == AxisOrder::NorthEast && m.src_type == PJ_TYPE_PROJECTED_CRS) m.swap_in = true;
   }
 
+  FrameTarget& base = m.base;
   if (!options.target_srs.empty()) {
     if (!m.src_known)
       throw InvalidArgument(m.where() + "a target CRS (" + options.target_srs +
                             ") was asked for, but the source CRS is unknown, so the data cannot be transformed; name it with "
                             "-s_srs (open option S_SRS)");
     SrsName t = parse_srs_name(options.target_srs);
-    m.working = m.create(t.definition);
-    if (m.working && proj_get_type(m.working.get()) == PJ_TYPE_COMPOUND_CRS)
-      m.working.reset(proj_crs_get_sub_crs(m.ctx, m.working.get(), 0));
-    if (!m.working || !m.projected_metric(m.working.get()))
+    base.working = m.create(t.definition);
+    if (base.working && proj_get_type(base.working.get()) == PJ_TYPE_COMPOUND_CRS)
+      base.working.reset(proj_crs_get_sub_crs(m.ctx, base.working.get(), 0));
+    if (!base.working || !m.projected_metric(base.working.get()))
       throw InvalidArgument("target CRS \"" + options.target_srs +
                             "\" is not a projected CRS in metres that PROJ knows (ground plans need a metric frame)");
-    m.fill_crs(m.working.get(), t.definition);
+    m.fill_crs(base, t.definition);
+    m.make_op(base);
+    m.base_decided = true;
   } else if (m.src_known && m.src_metric_projected) {
-    m.working.reset(proj_clone(m.ctx, m.src_h.get()));
-    m.crs_known_from(m.working.get());
-    m.crs.definition = m.crs.epsg ? "EPSG:" + std::to_string(m.crs.epsg) : m.source.definition;
-    m.identity = !m.swap_in;
-    m.decided = true;
+    base.working.reset(proj_clone(m.ctx, m.src_h.get()));
+    m.crs_known_from(base);
+    base.crs.definition = base.crs.epsg ? "EPSG:" + std::to_string(base.crs.epsg) : m.source.definition;
+    m.base_identity = !m.swap_in;
+    m.base_decided = true;
   } else if (!m.src_known) {
-    m.identity = true;
-    m.decided = true;
+    m.base_identity = true;
+    m.base_decided = true;
   }
-  if (m.working && !m.decided) {
-    m.make_op();
-    m.decided = true;
-  }
+  m.key = std::move(key);  // made whole: may be reused
+  m.begin(file);
+  ++g_setups;
 }
 
-WorkingFrame::~WorkingFrame() = default;
+std::size_t working_frame_setups() { return g_setups.load(); }
+
+WorkingFrame::~WorkingFrame() { give_back(std::move(impl_)); }
 WorkingFrame::WorkingFrame(WorkingFrame&&) noexcept = default;
-WorkingFrame& WorkingFrame::operator=(WorkingFrame&&) noexcept = default;
+WorkingFrame& WorkingFrame::operator=(WorkingFrame&& other) noexcept {
+  if (this != &other) {
+    give_back(std::move(impl_));
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
 
 void WorkingFrame::decide(double x, double y) {
   Impl& m = *impl_;
   if (m.decided) return;
   // Here the source is known and geographic (or projected in feet): pick the UTM zone of (x, y).
   if (m.swap_in) std::swap(x, y);
-  PjPtr src_in(proj_clone(m.ctx, m.src_h.get()));
-  PjPtr lonlat(proj_create(m.ctx, "OGC:CRS84"));
-  PjPtr to_ll(proj_create_crs_to_crs_from_pj(m.ctx, src_in.get(), lonlat.get(), nullptr, nullptr));
+  if (!m.to_ll_made) {
+    PjPtr src_in(proj_clone(m.ctx, m.src_h.get()));
+    PjPtr lonlat(proj_create(m.ctx, "OGC:CRS84"));
+    m.to_ll.reset(proj_create_crs_to_crs_from_pj(m.ctx, src_in.get(), lonlat.get(), nullptr, nullptr));
+    m.to_ll_made = true;
+  }
+  PJ* to_ll = m.to_ll.get();
   if (is_geographic(m.src_type)) {
     // Degrees: hundreds of thousands means the label is wrong (projected numbers under a geographic name).
     bool north_first = m.north_first(m.src_h.get());
@@ -236,18 +361,24 @@ void WorkingFrame::decide(double x, double y) {
                        "-s_srs (open option S_SRS), e.g. -s_srs EPSG:31467");
   }
   PJ_COORD c = proj_coord(x, y, 0, 0);
-  PJ_COORD ll = to_ll ? proj_trans(to_ll.get(), PJ_FWD, c) : c;
+  PJ_COORD ll = to_ll ? proj_trans(to_ll, PJ_FWD, c) : c;
   if (!to_ll || !std::isfinite(ll.xy.x) || !std::isfinite(ll.xy.y) || std::fabs(ll.xy.y) > 90.0)
     throw InputError(m.where() + "the point " + fmt(x) + ", " + fmt(y) + " is not a valid position in " + m.source.text +
                      ": the srsName contradicts the data; name the CRS the coordinates are in with -s_srs (open "
                      "option S_SRS)");
   int epsg = utm_epsg_for(ll.xy.x, ll.xy.y);
-  m.working.reset(proj_create(m.ctx, ("EPSG:" + std::to_string(epsg)).c_str()));
-  if (!m.working) throw Error("PROJ does not know EPSG:" + std::to_string(epsg) + " (is proj.db installed?)");
-  m.fill_crs(m.working.get(), "EPSG:" + std::to_string(epsg));
-  m.notes.push_back("source CRS " + m.source.text + " is not projected in metres: working CRS is " + m.crs.name +
-                    " (EPSG:" + std::to_string(epsg) + "), the UTM zone of the data's centre");
-  m.make_op();
+  auto zone = m.zones.find(epsg);
+  if (zone == m.zones.end()) {
+    FrameTarget t;
+    t.working.reset(proj_create(m.ctx, ("EPSG:" + std::to_string(epsg)).c_str()));
+    if (!t.working) throw Error("PROJ does not know EPSG:" + std::to_string(epsg) + " (is proj.db installed?)");
+    m.fill_crs(t, "EPSG:" + std::to_string(epsg));
+    m.make_op(t);
+    zone = m.zones.emplace(epsg, std::move(t)).first;
+  }
+  m.current = &zone->second;
+  m.notes.push_back("source CRS " + m.source.text + " is not projected in metres: working CRS is " +
+                    m.current->crs.name + " (EPSG:" + std::to_string(epsg) + "), the UTM zone of the data's centre");
   m.decided = true;
 }
 
@@ -257,8 +388,9 @@ bool WorkingFrame::transform_point(double& x, double& y) const {
   const Impl& m = *impl_;
   if (m.identity) return true;
   if (m.swap_in) std::swap(x, y);
-  if (!m.op) return true;  // projected metric source whose axes only needed swapping
-  PJ_COORD c = proj_trans(m.op.get(), PJ_FWD, proj_coord(x, y, 0, 0));
+  PJ* op = m.current ? m.current->op.get() : nullptr;
+  if (!op) return true;  // projected metric source whose axes only needed swapping
+  PJ_COORD c = proj_trans(op, PJ_FWD, proj_coord(x, y, 0, 0));
   if (!std::isfinite(c.xy.x) || !std::isfinite(c.xy.y)) return false;
   x = c.xy.x;
   y = c.xy.y;
@@ -279,15 +411,16 @@ bool WorkingFrame::transform(Mesh& mesh, std::string* reason) {
   std::vector<Point3>& v = mesh.vertices;
   if (m.swap_in)
     for (Point3& p : v) std::swap(p.x, p.y);
-  if (!m.op) return true;
+  PJ* op = m.current ? m.current->op.get() : nullptr;
+  if (!op) return true;
   const std::size_t n = v.size();
-  proj_errno_reset(m.op.get());
-  proj_trans_generic(m.op.get(), PJ_FWD, &v[0].x, sizeof(Point3), n, &v[0].y, sizeof(Point3), n, nullptr, 0, 0,
+  proj_errno_reset(op);
+  proj_trans_generic(op, PJ_FWD, &v[0].x, sizeof(Point3), n, &v[0].y, sizeof(Point3), n, nullptr, 0, 0,
                      nullptr, 0, 0);
   for (const Point3& p : v) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || std::fabs(p.x) > 1e15 || std::fabs(p.y) > 1e15) {
       if (reason)
-        *reason = "a vertex cannot be transformed from " + m.source.text + " to " + m.crs.name +
+        *reason = "a vertex cannot be transformed from " + m.source.text + " to " + m.current->crs.name +
                   " (out of the CRS's domain, or the srsName does not fit the coordinates)";
       return false;
     }
@@ -375,7 +508,10 @@ bool WorkingFrame::source_known() const { return impl_->src_known; }
 bool WorkingFrame::source_geographic() const { return is_geographic(impl_->src_type); }
 bool WorkingFrame::identity() const { return impl_->identity; }
 const SrsName& WorkingFrame::source() const { return impl_->source; }
-const WorkingCrs& WorkingFrame::working_crs() const { return impl_->crs; }
+const WorkingCrs& WorkingFrame::working_crs() const {
+  static const WorkingCrs kNone;
+  return impl_->current ? impl_->current->crs : kNone;
+}
 const std::vector<std::string>& WorkingFrame::notes() const { return impl_->notes; }
 
 }  // namespace groundplan::gis

@@ -10,7 +10,9 @@
 // is read easting first whatever its EPSG axis order says, as every CityGML producer writes it.
 // CrsOptions::source_axis overrides this for files that break the rule.
 //
-// Not thread-safe: one WorkingFrame (it owns a PJ_CONTEXT) per thread.
+// Not thread-safe: one WorkingFrame (it owns a PJ_CONTEXT while it lives) is used by one thread at a time.
+// Frames are cheap to make again: a finished frame's PROJ objects are kept and handed to the next frame
+// made with the same arguments (working_frame.cpp says why and how).
 #include <groundplan/mesh.h>
 
 #include <memory>
@@ -98,10 +100,17 @@ class WorkingFrame {
   /// Things a person should know (CRS unknown, axis order guessed ...): one sentence each.
   const std::vector<std::string>& notes() const;
 
+  struct Impl;  // opaque
+
  private:
-  struct Impl;
+  static std::unique_ptr<Impl> take_pooled(const std::string& key);
+  static void give_back(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+/// How many frames have made their PROJ objects afresh since the process started (the others reused a
+/// finished frame's). For tests and statistics.
+std::size_t working_frame_setups();
 
 /// The WGS 84 UTM zone EPSG code (326zz north, 327zz south) for a longitude/latitude in degrees.
 int utm_epsg_for(double lon_deg, double lat_deg);
