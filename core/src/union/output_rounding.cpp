@@ -129,6 +129,12 @@ bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) 
 }
 
 bool touch_cycle(const std::vector<std::vector<Point2>*>& rings) {
+  // only a cycle through a hole counts: without a hole there is nothing to look for (most groups)
+  std::vector<char> hole(rings.size(), 0);
+  bool any_hole = false;
+  for (std::size_t r = 0; r < rings.size(); ++r)
+    any_hole |= hole[r] = rings[r]->size() >= 3 && ring_orientation(*rings[r]) < 0;
+  if (!any_hole) return false;
   // the graph of rings and touch points, each point one node; an incidence (ring, point) joining two
   // nodes already connected closes a cycle
   struct Seg {
@@ -180,8 +186,8 @@ bool touch_cycle(const std::vector<std::vector<Point2>*>& rings) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  std::vector<char> hole(parent.size(), 0), cycle(parent.size(), 0);
-  for (std::size_t r = 0; r < rings.size(); ++r) hole[r] = rings[r]->size() >= 3 && ring_orientation(*rings[r]) < 0;
+  hole.resize(parent.size(), 0);
+  std::vector<char> cycle(parent.size(), 0);
   std::size_t node = rings.size();
   for (std::size_t k = 0; k < inc.size(); ++k) {
     if (k > 0 && inc[k].first != inc[k - 1].first) ++node;
