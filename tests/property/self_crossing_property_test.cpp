@@ -12,6 +12,8 @@
 // cases strict-equal; 32 near-touch (valid output that near-touches is not snap-rounded:
 // snap_round.h kSnapNearTouch), 11 other polygon/hole counts; with near-touch snapped too (the
 // constant on) 990/1000, 1 near-touch, but large_offsets cases then differ from GEOS in counts.
+// Branch robust20 (touch_cycle: a hole touching its shell twice is snap-rounded): 970 strict-equal,
+// 27 near-touch, 12 other counts; constant on: 990, 1 near-touch, 12 other counts.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <numeric>
+#include <utility>
 
 #include "robust/predicates.h"
 
@@ -122,6 +125,83 @@ bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) 
       }
     }
   }
+  return false;
+}
+
+bool touch_cycle(const std::vector<std::vector<Point2>*>& rings) {
+  // only a cycle through a hole counts: without a hole there is nothing to look for (most groups)
+  std::vector<char> hole(rings.size(), 0);
+  bool any_hole = false;
+  for (std::size_t r = 0; r < rings.size(); ++r)
+    any_hole |= hole[r] = rings[r]->size() >= 3 && ring_orientation(*rings[r]) < 0;
+  if (!any_hole) return false;
+  // the graph of rings and touch points, each point one node; an incidence (ring, point) joining two
+  // nodes already connected closes a cycle
+  struct Seg {
+    double minx, maxx, miny, maxy;
+    std::size_t ring, edge;
+  };
+  std::vector<Seg> segs;
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    const auto& R = *rings[r];
+    for (std::size_t i = 0, n = R.size(); i < n; ++i) {
+      const Point2& a = R[i];
+      const Point2& b = R[(i + 1) % n];
+      segs.push_back({std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), r, i});
+    }
+  }
+  std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.minx < y.minx; });
+  auto pt = [&](std::size_t r, std::size_t i) -> const Point2& { return (*rings[r])[i % rings[r]->size()]; };
+  // touches: (point, ring) for both rings of every touch; collected first, then deduplicated
+  std::vector<std::pair<std::pair<double, double>, std::size_t>> inc;
+  auto on_closed = [](const Point2& a, const Point2& b, const Point2& p) {
+    return orient(a, b, p) == 0 && std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) &&
+           std::min(a.y, b.y) <= p.y && p.y <= std::max(a.y, b.y);
+  };
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    for (std::size_t j = i + 1; j < segs.size() && segs[j].minx <= segs[i].maxx; ++j) {
+      const Seg& s = segs[i];
+      const Seg& t = segs[j];
+      if (s.ring == t.ring || t.miny > s.maxy || s.miny > t.maxy) continue;
+      const Point2 &p1 = pt(s.ring, s.edge), &p2 = pt(s.ring, s.edge + 1);
+      const Point2 &q1 = pt(t.ring, t.edge), &q2 = pt(t.ring, t.edge + 1);
+      for (const Point2* q : {&q1, &q2})
+        if (on_closed(p1, p2, *q)) {
+          inc.push_back({{q->x, q->y}, s.ring});
+          inc.push_back({{q->x, q->y}, t.ring});
+        }
+      for (const Point2* p : {&p1, &p2})
+        if (on_closed(q1, q2, *p)) {
+          inc.push_back({{p->x, p->y}, s.ring});
+          inc.push_back({{p->x, p->y}, t.ring});
+        }
+    }
+  }
+  if (inc.empty()) return false;
+  std::sort(inc.begin(), inc.end());
+  inc.erase(std::unique(inc.begin(), inc.end()), inc.end());
+  std::vector<std::size_t> parent(rings.size() + inc.size());
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  auto find = [&](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  hole.resize(parent.size(), 0);
+  std::vector<char> cycle(parent.size(), 0);
+  std::size_t node = rings.size();
+  for (std::size_t k = 0; k < inc.size(); ++k) {
+    if (k > 0 && inc[k].first != inc[k - 1].first) ++node;
+    const std::size_t a = find(node), b = find(inc[k].second);
+    if (a == b) {
+      cycle[a] = 1;
+      continue;
+    }
+    parent[a] = b;
+    hole[b] |= hole[a];
+    cycle[b] |= cycle[a];
+  }
+  for (std::size_t x = 0; x < parent.size(); ++x)
+    if (parent[x] == x && hole[x] && cycle[x]) return true;
   return false;
 }
 

@@ -17,5 +17,11 @@ struct Conflict {
   std::size_t ring_a, edge_a, ring_b, edge_b;
 };
 bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c);
+/// Whether rings that touch one another at points (a vertex of one equal to a vertex of, or on an edge
+/// of, another) close a cycle through a hole (a clockwise ring): a hole touching its shell at two
+/// points, or a chain of holes touching back to the shell. Within one plan that is OGC's "interior is
+/// disconnected"; a cycle of shells only (plans sharing two vertices) is valid and not reported. Rings
+/// are "union on the left" (holes clockwise); a ring touching itself is find_conflict's concern.
+bool touch_cycle(const std::vector<std::vector<Point2>*>& rings);
 
 }  // namespace groundplan::detail

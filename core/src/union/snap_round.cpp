@@ -416,6 +416,9 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
     for (const auto& r : rings) rr.push_back(const_cast<std::vector<Point2>*>(&r));
     Conflict c{};
     if (find_conflict(rr, c)) return false;
+    // a hole touching its shell at two points passes find_conflict (rings of one plan may touch) but
+    // is invalid (interior disconnected): the 9ec94c3b fuzz regression
+    if (touch_cycle(rr)) return false;
   }
   if (!near) return true;
   std::vector<Point2> pts;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "near_touch.h"
+#include "union/output_rounding.h"
 #include "union/snap_round.h"
 #include "union_test_util.h"
 
@@ -243,6 +244,45 @@ TEST(SnapRound, DenseCrossingsAtUtmMagnitudeGiveCleanPlans) {
     EXPECT_EQ(c.cmp.overlapping_ours, 0u) << "round " << round << ": " << c.message;
     for (const Problem& p : c.problems) EXPECT_NE(p.code, "ROUNDING_INVALID") << p.reason;
   }
+}
+
+// A hole touching its shell at two points passes find_conflict (rings of one plan may touch at
+// points) but splits the plan's interior (OGC "Interior is disconnected", fuzz regression 9ec94c3b):
+// clean_as_rounded must refuse it, so that the group is snap-rounded and comes out as two shells.
+TEST(SnapRound, HoleTouchingItsShellTwiceIsNotClean) {
+  const std::vector<Point2> shell{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  // clockwise hole (union on the left) with vertices (0,5) on the shell's left edge and (10,5) on its right
+  const std::vector<Point2> hole2{{0, 5}, {5, 8}, {10, 5}, {5, 2}};
+  const std::vector<Point2> hole1{{0, 5}, {5, 8}, {8, 5}, {5, 2}};  // touching once: valid
+  const double g = detail::snap_pitch(10);
+  std::vector<std::vector<Point2>*> two{const_cast<std::vector<Point2>*>(&shell), const_cast<std::vector<Point2>*>(&hole2)};
+  std::vector<std::vector<Point2>*> one{const_cast<std::vector<Point2>*>(&shell), const_cast<std::vector<Point2>*>(&hole1)};
+  detail::Conflict c{};
+  EXPECT_FALSE(detail::find_conflict(two, c));  // the gap this closes
+  EXPECT_TRUE(detail::touch_cycle(two));
+  EXPECT_FALSE(detail::touch_cycle(one));
+  EXPECT_FALSE(detail::clean_as_rounded({shell, hole2}, g, false));
+  EXPECT_TRUE(detail::clean_as_rounded({shell, hole1}, g, false));
+}
+
+TEST(SnapRound, TouchCycleThroughAChainOfHolesButNotThroughShellsOnly) {
+  const std::vector<Point2> shell{{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  // two clockwise holes: the first touches the shell at (0,5), the second touches the first at (5,5)
+  // and the shell at (10,5): shell - hole - hole - shell is a cycle, the interior is cut in two
+  const std::vector<Point2> ha{{0, 5}, {2, 7}, {5, 5}, {2, 3}};
+  const std::vector<Point2> hb{{5, 5}, {7, 7}, {10, 5}, {7, 3}};
+  std::vector<std::vector<Point2>*> chain{const_cast<std::vector<Point2>*>(&shell), const_cast<std::vector<Point2>*>(&ha),
+                                          const_cast<std::vector<Point2>*>(&hb)};
+  EXPECT_TRUE(detail::touch_cycle(chain));
+  std::vector<std::vector<Point2>*> open_chain{const_cast<std::vector<Point2>*>(&shell),
+                                               const_cast<std::vector<Point2>*>(&ha)};
+  EXPECT_FALSE(detail::touch_cycle(open_chain));
+  // two counter-clockwise shells sharing two vertices (L-shapes around a courtyard): valid OGC
+  // multipolygon, not a cycle through a hole
+  const std::vector<Point2> l1{{0, 0}, {4, 0}, {4, 1}, {1, 1}, {1, 4}, {0, 4}};
+  const std::vector<Point2> l2{{4, 1}, {5, 1}, {5, 5}, {1, 5}, {1, 4}, {4, 4}};
+  std::vector<std::vector<Point2>*> shells{const_cast<std::vector<Point2>*>(&l1), const_cast<std::vector<Point2>*>(&l2)};
+  EXPECT_FALSE(detail::touch_cycle(shells));
 }
 
 }  // namespace
