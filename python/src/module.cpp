@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <cstring>
 #include <ctime>
+#include <dlfcn.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
 #include <exception>
@@ -334,6 +335,45 @@ GEOSGeometry* geos_polygon(GEOSContextHandle_t h, const Polygon& poly) {
     return nullptr;
   }
   return GEOSGeom_createPolygon_r(h, shell, holes.data(), static_cast<unsigned int>(holes.size()));  // takes the rings
+}
+
+/// Shapely 2 objects owning the GEOS polygons at `addresses`, made by Shapely's own C API (the capsule
+/// "shapely.lib._C_API" of shapely/src/c_api.h; entry 0: PyObject* CreateGeometry(GEOSGeometry*, context)).
+/// Only for a Shapely whose libgeos_c is this module's (the wrapper checks). On failure the geometries not
+/// yet taken over are freed. GIL held.
+py::list shapely2_geometries(const std::vector<std::uintptr_t>& addresses) {
+  std::size_t i = 0;
+  auto free_rest = [&] {
+    for (std::size_t k = i; k < addresses.size(); ++k)
+      if (addresses[k]) GEOSGeom_destroy_r(geos_handle(), reinterpret_cast<GEOSGeometry*>(addresses[k]));
+  };
+  void** api = static_cast<void**>(PyCapsule_Import("shapely.lib._C_API", 0));
+  if (!api) {
+    free_rest();
+    throw py::error_already_set();
+  }
+  using Create = PyObject* (*)(GEOSGeometry*, GEOSContextHandle_t);
+  const auto create = reinterpret_cast<Create>(api[0]);
+  py::list out(addresses.size());
+  for (; i < addresses.size(); ++i) {
+    PyObject* o = create(reinterpret_cast<GEOSGeometry*>(addresses[i]), geos_handle());
+    if (!o) {  // Shapely did not take this one over
+      free_rest();
+      throw py::error_already_set();
+    }
+    PyList_SET_ITEM(out.ptr(), static_cast<Py_ssize_t>(i), o);  // steals the reference
+  }
+  return out;
+}
+
+/// The address of GEOSversion as the shared object `path` (already loaded) binds it: the libgeos_c that
+/// Shapely 2's extension uses, to compare with this module's.
+std::uintptr_t geos_version_address_in(const std::string& path) {
+  void* h = dlopen(path.c_str(), RTLD_LAZY | RTLD_NOLOAD);
+  if (!h) return 0;
+  void* sym = dlsym(h, "GEOSversion");
+  dlclose(h);
+  return reinterpret_cast<std::uintptr_t>(sym);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -746,6 +786,10 @@ PYBIND11_MODULE(_groundplan, m) {
           if (a) GEOSGeom_destroy_r(geos_handle(), reinterpret_cast<GEOSGeometry*>(a));
       },
       py::arg("addresses"), "Frees GEOS geometries given by union_*(geos_out=True) that no Shapely object took over");
+  m.def("shapely2_geometries", &shapely2_geometries, py::arg("addresses"),
+        "Shapely 2 objects owning the GEOS polygons given by union_*(geos_out=True), made by Shapely's C API");
+  m.def("geos_version_address_in", &geos_version_address_in, py::arg("path"),
+        "The address of GEOSversion that the loaded shared object `path` binds (0 if not loaded)");
   m.def("read", &read_inputs, py::arg("inputs"), py::arg("options"), py::arg("progress"),
         "read(inputs: list[str], options: dict[str, str], progress) -> dict(layers=..., crs_wkt=..., crs_name=..., stats=...)");
 }

@@ -31,6 +31,7 @@ import time
 
 import groundplan
 import shapely
+import shapely.wkb
 from shapely.ops import unary_union
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python"))
@@ -147,8 +148,12 @@ def main():
                     help="a libgeos_c.so.1 of GEOS >= 3.12 (default: $GEOS_DSU_LIB); absent: DSU skipped")
     ap.add_argument("--dsu-threads", type=int, default=1, help="groundplan's threads in the DSU comparison (1 core)")
     ap.add_argument("--no-unary-union", action="store_true", help="skip shapely.ops.unary_union (slow)")
+    ap.add_argument("--wkb", action="store_true",
+                    help="force the WKB route (what a Shapely with a libgeos_c of its own, e.g. a wheel, gets)")
     ap.add_argument("--input", nargs="*", help="CityGML/CityJSON ... whose footprints to unite instead")
     a = ap.parse_args()
+    if a.wkb:
+        groundplan._geos_addresses = lambda geometries: None
     if a.input:
         geoms = [g for g in groundplan.read(a.input).footprints.geometry if g.is_valid and not g.is_empty]
         what = f"{len(geoms)} valid real footprints from {' '.join(a.input)}"
@@ -156,7 +161,8 @@ def main():
         geoms = block_city(a.n)
         what = f"{len(geoms)} generated footprints"
     geos_version = shapely.geos_version_string if SHAPELY2 else shapely.geos.geos_version_string
-    print(f"# {what}; shapely {shapely.__version__}, GEOS {geos_version}; groundplan from {groundplan.__file__}")
+    print(f"# {what}; shapely {shapely.__version__}, GEOS {geos_version}; groundplan from {groundplan.__file__}"
+          f"{'; WKB route forced' if a.wkb else ''}")
     dsu = None
     if a.dsu_lib:
         try:
