@@ -47,7 +47,7 @@ def median_of(runs, key):
 class Dsu:
     """GEOSDisjointSubsetUnion_r of a libgeos_c of its own (loaded apart from Shapely's: RTLD_DEEPBIND)."""
 
-    def __init__(self, path):
+    def __init__(self, path, symbol="GEOSDisjointSubsetUnion_r"):
         lib = ctypes.CDLL(path, mode=os.RTLD_LOCAL | getattr(os, "RTLD_DEEPBIND", 0))
         vp, sz = ctypes.c_void_p, ctypes.c_size_t
         for name, res, args in (
@@ -57,13 +57,13 @@ class Dsu:
             ("GEOSWKBReader_read_r", vp, [vp, vp, ctypes.c_char_p, sz]),
             ("GEOSWKBWriter_create_r", vp, [vp]),
             ("GEOSWKBWriter_write_r", ctypes.POINTER(ctypes.c_char), [vp, vp, vp, ctypes.POINTER(sz)]),
-            ("GEOSDisjointSubsetUnion_r", vp, [vp, vp]),
+            (symbol, vp, [vp, vp]),
             ("GEOSGeom_destroy_r", None, [vp, vp]),
             ("GEOSFree_r", None, [vp, vp]),
         ):
             f = getattr(lib, name)  # AttributeError: a GEOS without DisjointSubsetUnion (< 3.12)
             f.restype, f.argtypes = res, args
-        self.lib = lib
+        self.lib, self.union = lib, getattr(lib, symbol)
         self.version = lib.GEOSversion().decode()
         self.h = lib.GEOS_init_r()
         self.reader = lib.GEOSWKBReader_create_r(self.h)
@@ -76,10 +76,10 @@ class Dsu:
         g = lib.GEOSWKBReader_read_r(h, self.reader, collection, len(collection))
         if not g:
             raise RuntimeError("DSU's GEOS could not read the footprints")
-        u = lib.GEOSDisjointSubsetUnion_r(h, g)
+        u = self.union(h, g)
         lib.GEOSGeom_destroy_r(h, g)
         if not u:
-            raise RuntimeError("GEOSDisjointSubsetUnion_r failed")
+            raise RuntimeError("the union of DSU's GEOS failed")
         size = ctypes.c_size_t()
         buf = lib.GEOSWKBWriter_write_r(h, self.writer, u, ctypes.byref(size))
         out = ctypes.string_at(buf, size.value)
@@ -146,6 +146,8 @@ def main():
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--dsu-lib", default=os.environ.get("GEOS_DSU_LIB"),
                     help="a libgeos_c.so.1 of GEOS >= 3.12 (default: $GEOS_DSU_LIB); absent: DSU skipped")
+    ap.add_argument("--dsu-symbol", default="GEOSDisjointSubsetUnion_r",
+                    help="GEOSUnaryUnion_r checks this comparison's plumbing with a GEOS < 3.12 (not a DSU figure)")
     ap.add_argument("--dsu-threads", type=int, default=1, help="groundplan's threads in the DSU comparison (1 core)")
     ap.add_argument("--no-unary-union", action="store_true", help="skip shapely.ops.unary_union (slow)")
     ap.add_argument("--wkb", action="store_true",
@@ -166,8 +168,8 @@ def main():
     dsu = None
     if a.dsu_lib:
         try:
-            dsu = Dsu(a.dsu_lib)
-            print(f"# DisjointSubsetUnion from {a.dsu_lib} (GEOS {dsu.version})")
+            dsu = Dsu(a.dsu_lib, a.dsu_symbol)
+            print(f"# {a.dsu_symbol} from {a.dsu_lib} (GEOS {dsu.version})")
         except (OSError, AttributeError) as e:
             print(f"# DisjointSubsetUnion skipped: {a.dsu_lib}: {e}")
     else:
@@ -194,7 +196,7 @@ def main():
             print(f"# plans {len(r.plans)}; area {sum(r.areas):.1f} vs GEOS {ref.area:.1f}")
     if dsu is not None:
         area = sum(p.area for p in dsu_plans)
-        print(f"# DSU: {len(dsu_plans)} polygons, area {area:.3f}; groundplan: {len(r1.plans)} plans, area {sum(r1.areas):.3f}")
+        print(f"# {a.dsu_symbol}: {len(dsu_plans)} polygons, area {area:.3f}; groundplan: {len(r1.plans)} plans, area {sum(r1.areas):.3f}")
 
     total, total_cpu = report_ours(f"threads={a.threads}", ours)
     if not a.no_unary_union:
@@ -204,8 +206,8 @@ def main():
     if dsu is not None:
         t1, c1 = report_ours(f"threads={a.dsu_threads}", ours1)
         d, dc = median_of(dsus, "total"), median_of(dsus, "total_cpu")
-        print(f"| GEOS DisjointSubsetUnion (WKB in and out, Shapely conversion included) | {d:.4f} | {dc:.4f} |")
-        print(f"# DSU / groundplan.union(threads={a.dsu_threads}), conversion in and out of Python included: "
+        print(f"| GEOS {a.dsu_symbol} (WKB in and out, Shapely conversion included) | {d:.4f} | {dc:.4f} |")
+        print(f"# {a.dsu_symbol} / groundplan.union(threads={a.dsu_threads}), conversion in and out of Python included: "
               f"{d / t1:.2f}x wall, {dc / c1:.2f}x CPU")
 
 
