@@ -38,11 +38,14 @@ class UnionResult(NamedTuple):
     problems: input geometries that are in no plan, and notes, as dicts with the keys
               ``index`` (the input position, or None), ``stage``, ``code`` (e.g. ``NOT_FINITE``, ``NO_AREA``)
               and ``reason``.
-    timings:  seconds spent in each step: ``to_wkb_s`` (Shapely -> WKB, or the GEOS addresses, Python),
-              ``parse_s`` (WKB or GEOS -> engine),
-              ``union_s``, ``write_s`` (plans -> WKB), ``to_python_s`` (bytes objects), ``from_wkb_s``
-              (WKB -> Shapely, Python), ``total_s``; ``route``: "wkb", or "geos" where Shapely 1.x shares this
-              module's libgeos_c (the engine then reads Shapely's GEOS geometries directly).
+    timings:  seconds spent in each step, wall clock (``*_s``) and CPU time of the whole process
+              (``*_cpu_s``): ``to_wkb`` (Shapely -> WKB bytes or GEOS addresses, Python), ``parse`` (-> the
+              engine's footprints, C++; ``parse_alloc_s`` of it allocating them), ``union``, ``write`` (plans ->
+              GEOS polygons or WKB, C++), ``to_python`` (the Python lists), ``from_wkb`` (-> Shapely polygons,
+              Python), ``call`` and ``total``; ``parse_minor_faults`` and ``union_minor_faults`` (page faults:
+              a process's first call pays for fresh memory); ``route``: "geos" where Shapely's libgeos_c is
+              this module's (Debian's Shapely 1.8, or a Shapely 2 built against the system GEOS: geometries
+              cross as GEOS pointers both ways), else "wkb" (e.g. a Shapely 2 wheel, which brings its own GEOS).
     """
 
     plans: List[Any]
