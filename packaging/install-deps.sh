@@ -26,6 +26,9 @@ packages=(
   # the Python module (issue 23, python/): pybind11 and the headers to build it; Shapely, GeoPandas (Fiona,
   # pyproj) for its wrapper and tests. Debian bookworm has no pyogrio: its test skips.
   python3-dev pybind11-dev python3-shapely python3-fiona python3-pyproj python3-numpy
+  # cython3: to build Shapely 2.0 from its source for the module's tests with Shapely 2 (bookworm packages 1.8;
+  # tests/python/build_shapely2.sh, -DGROUNDPLAN_SHAPELY2_DIR)
+  cython3
   # QGIS as a client (issue 18, qgis/ and tests/e2e/test_qgis*.py): PyQGIS and the OGR provider to load and
   # render the driver's layers, qgis for qgis_process (runs the Processing algorithm), xvfb for headless runs
   python3-qgis qgis-providers qgis xvfb

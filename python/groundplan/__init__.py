@@ -38,11 +38,14 @@ class UnionResult(NamedTuple):
     problems: input geometries that are in no plan, and notes, as dicts with the keys
               ``index`` (the input position, or None), ``stage``, ``code`` (e.g. ``NOT_FINITE``, ``NO_AREA``)
               and ``reason``.
-    timings:  seconds spent in each step: ``to_wkb_s`` (Shapely -> WKB, or the GEOS addresses, Python),
-              ``parse_s`` (WKB or GEOS -> engine),
-              ``union_s``, ``write_s`` (plans -> WKB), ``to_python_s`` (bytes objects), ``from_wkb_s``
-              (WKB -> Shapely, Python), ``total_s``; ``route``: "wkb", or "geos" where Shapely 1.x shares this
-              module's libgeos_c (the engine then reads Shapely's GEOS geometries directly).
+    timings:  seconds spent in each step, wall clock (``*_s``) and CPU time of the whole process
+              (``*_cpu_s``): ``to_wkb`` (Shapely -> WKB bytes or GEOS addresses, Python), ``parse`` (-> the
+              engine's footprints, C++; ``parse_alloc_s`` of it allocating them), ``union``, ``write`` (plans ->
+              GEOS polygons or WKB, C++), ``to_python`` (the Python lists), ``from_wkb`` (-> Shapely polygons,
+              Python), ``call`` and ``total``; ``parse_minor_faults`` and ``union_minor_faults`` (page faults:
+              a process's first call pays for fresh memory); ``route``: "geos" where Shapely's libgeos_c is
+              this module's (Debian's Shapely 1.8, or a Shapely 2 built against the system GEOS: geometries
+              cross as GEOS pointers both ways), else "wkb" (e.g. a Shapely 2 wheel, which brings its own GEOS).
     """
 
     plans: List[Any]
@@ -75,10 +78,16 @@ class ReadResult(NamedTuple):
     stats: Dict[str, Any]
 
 
-def _shapely_major() -> int:
-    import shapely
+_SHAPELY_MAJOR: Optional[int] = None
 
-    return int(shapely.__version__.split(".")[0])
+
+def _shapely_major() -> int:
+    global _SHAPELY_MAJOR
+    if _SHAPELY_MAJOR is None:
+        import shapely
+
+        _SHAPELY_MAJOR = int(shapely.__version__.split(".")[0])
+    return _SHAPELY_MAJOR
 
 
 def _to_wkb(geometries: Iterable[Any]) -> List[bytes]:
@@ -92,7 +101,14 @@ def _to_wkb(geometries: Iterable[Any]) -> List[bytes]:
         import numpy as np
         import shapely
 
-        arr = np.asarray(list(geometries) if not isinstance(geometries, np.ndarray) else geometries, dtype=object)
+        # np.fromiter: np.asarray probes each object for the sequence protocol (35 ms for 60k geometries)
+        if isinstance(geometries, np.ndarray):
+            arr = geometries
+        else:
+            try:
+                arr = np.fromiter(geometries, dtype=object, count=len(geometries))
+            except (TypeError, ValueError):  # NumPy < 1.23 has no object dtype in fromiter
+                arr = np.asarray(geometries, dtype=object)
         return list(shapely.to_wkb(arr, output_dimension=2))
     out = []
     for i, g in enumerate(geometries):
@@ -106,20 +122,38 @@ def _to_wkb(geometries: Iterable[Any]) -> List[bytes]:
     return out
 
 
+_SHARES_GEOS: Optional[bool] = None
+
+
+def _shares_geos() -> bool:
+    """Whether Shapely's libgeos_c is the very library this module links (same address of GEOSversion):
+    Debian's Shapely 1.8, or a Shapely 2 built against the system's GEOS (not a wheel with its own copy).
+    Then geometries cross as GEOS pointers both ways, with no WKB."""
+    global _SHARES_GEOS
+    if _SHARES_GEOS is None:
+        try:
+            ours = _groundplan.geos_version_address()
+            if _shapely_major() >= 2:
+                import shapely.lib
+
+                theirs = _groundplan.geos_version_address_in(shapely.lib.__file__)
+            else:
+                import ctypes
+
+                from shapely.geos import lgeos
+
+                theirs = ctypes.cast(lgeos._lgeos.GEOSversion, ctypes.c_void_p).value
+            _SHARES_GEOS = bool(theirs) and ours == theirs
+        except Exception:  # another Shapely layout: the WKB route
+            _SHARES_GEOS = False
+    return _SHARES_GEOS
+
+
 def _geos_addresses(geometries: Sequence[Any]) -> Optional[List[int]]:
-    """Shapely 1.x: the addresses of the GEOS geometries behind `geometries`, when Shapely's libgeos_c is the one
-    this module links (then the engine reads them directly: 10x faster than .wkb, one Python call per
-    geometry); else None (-> WKB)."""
-    try:
-        import ctypes
-
-        from shapely.geos import lgeos
-
-        ours = _groundplan.geos_version_address()
-        theirs = ctypes.cast(lgeos._lgeos.GEOSversion, ctypes.c_void_p).value
-    except Exception:  # another Shapely layout: the WKB route
-        return None
-    if ours != theirs:
+    """The addresses of the GEOS geometries behind `geometries` (Shapely 1.x and 2.x both expose ``_geom``),
+    when Shapely's libgeos_c is the one this module links (then the engine reads them directly: 10x faster
+    than ``.wkb`` on Shapely 1.8); else None (-> WKB)."""
+    if not _shares_geos():
         return None
     try:
         addresses = [g._geom for g in geometries]
@@ -128,6 +162,48 @@ def _geos_addresses(geometries: Sequence[Any]) -> Optional[List[int]]:
     if not all(type(a) is int and a for a in addresses):
         return None
     return addresses
+
+
+def _shapely1_polygon_maker() -> Callable[[int], Any]:
+    """Shapely 1.8: a function that makes a Shapely Polygon owning a GEOS polygon (given by its address).
+
+    Shapely's own ``geom_factory`` asks GEOS for the type and the dimension through ctypes and sets six
+    attributes through Shapely's ``__setattr__`` (about 7 us a plan); the plans are all 2D Polygons, so this
+    sets what ``geom_factory`` would set (``__geom__``, ``_is_empty``, ``_ndim``; ``__p__`` and
+    ``_other_owned`` keep their class defaults: no parent, owned) straight into the new object's ``__dict__``
+    (about 1 us). Shapely 1.8's attributes are checked first; with another layout, ``geom_factory``."""
+    from shapely.geometry import Polygon
+    from shapely.geometry.base import BaseGeometry, geom_factory
+
+    layout = all(hasattr(BaseGeometry, a) for a in ("__geom__", "__p__", "_other_owned", "_is_empty", "_ndim", "_empty"))
+    if not layout or hasattr(Polygon, "__slots__") or BaseGeometry._other_owned is not False:
+        return geom_factory
+    new = object.__new__
+
+    def make(address: int) -> Any:
+        ob = new(Polygon)
+        d = ob.__dict__
+        d["__geom__"] = address
+        d["_is_empty"] = False
+        d["_ndim"] = 2
+        return ob
+
+    return make
+
+
+def _own_geos(addresses: List[int]) -> List[Any]:
+    """Shapely objects for the GEOS polygons that union_*(geos_out=True) made; frees the rest on failure."""
+    if _shapely_major() >= 2:
+        return _groundplan.shapely2_geometries(addresses)  # Shapely's C API; frees the rest itself
+    out: List[Any] = []
+    try:
+        make = _shapely1_polygon_maker()
+        for a in addresses:
+            out.append(make(a))
+    except BaseException:
+        _groundplan.destroy_geos(addresses[len(out):])
+        raise
+    return out
 
 
 def _from_wkb(wkbs: Sequence[Optional[bytes]]) -> List[Any]:
@@ -176,16 +252,18 @@ def union(
     Returns a :class:`UnionResult` (plans, members, areas, problems, timings).
     Raises ValueError for bad arguments, TypeError for non-polygonal input, KeyboardInterrupt on Ctrl-C.
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     if hasattr(geometries, "geom_type") and hasattr(geometries, "values"):  # GeoSeries: its positions, not its index
         geometries = list(geometries.values)
     held = geometries if isinstance(geometries, list) else list(geometries)  # alive until the engine has read them
-    addresses = _geos_addresses(held) if _shapely_major() < 2 else None
+    addresses = _geos_addresses(held)
     call = _groundplan.union_geos if addresses is not None else _groundplan.union_wkb
     data = addresses if addresses is not None else _to_wkb(held)
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     r = call(
         data,
+        # Shapely 1.x sharing this module's libgeos_c: the plans come back as GEOS polygons, not WKB
+        geos_out=addresses is not None,
         threads=int(threads),
         resolution=float(resolution),
         device=str(device),
@@ -196,11 +274,12 @@ def union(
         min_area=float(min_area),
         progress=progress,
     )
-    t2 = time.perf_counter()
-    plans = _from_wkb(r["plans"])
-    t3 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.process_time()
+    plans = _own_geos(r["plans"]) if addresses is not None else _from_wkb(r["plans"])
+    t3, c3 = time.perf_counter(), time.process_time()
     timings = dict(r["timings"])
     timings.update(to_wkb_s=t1 - t0, from_wkb_s=t3 - t2, call_s=t2 - t1, total_s=t3 - t0,
+                   to_wkb_cpu_s=c1 - c0, from_wkb_cpu_s=c3 - c2, call_cpu_s=c2 - c1, total_cpu_s=c3 - c0,
                    route="geos" if addresses is not None else "wkb")
     del held
     return UnionResult(plans, r["members"], r["areas"], r["problems"], timings)

@@ -32,6 +32,10 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstring>
+#include <ctime>
+#include <dlfcn.h>
+#include <sys/mman.h>
+#include <sys/resource.h>
 #include <exception>
 #include <functional>
 #include <map>
@@ -39,6 +43,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace py = pybind11;
@@ -53,6 +58,38 @@ struct NotPolygonal : std::runtime_error {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// CPU seconds of the whole process, all threads (the stages of union() run one after the other, so the
+/// difference around a stage is that stage's CPU time, whatever the number of threads it used).
+double process_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+/// Asks Linux for transparent huge pages behind a large buffer we own and have not touched yet: its first
+/// touch then costs one page fault per 2 MiB instead of one per 4 KiB. The vector of 60k footprints is 8 MB
+/// of fresh memory on every call (glibc maps and unmaps it); on the VM of tests/bench/RESULTS.md a page
+/// fault costs ~50 us and these faults were 0.11 s of a 0.5 s call, the largest part of the conversion.
+/// Only advice: where THP is off, or the range holds no whole huge page, nothing changes.
+void advise_huge_pages(void* data, std::size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr std::uintptr_t huge = 2u << 20;
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + huge - 1) & ~(huge - 1);
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(huge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
+/// Minor page faults of the process so far (first touches of fresh memory: what makes a first call slower).
+long minor_faults() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_minflt;
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -192,12 +229,30 @@ std::string polygon_wkb(const Polygon& poly) {
 // here with the GEOS C API. Only used when Shapely's libgeos_c is the very library this module links (the
 // wrapper compares the addresses of GEOSversion), and the Python list of geometries keeps them alive.
 
+/// One GEOS context per thread (the reentrant API's handles are not to be shared between threads).
+GEOSContextHandle_t geos_handle() {
+  thread_local struct Handle {
+    GEOSContextHandle_t h = GEOS_init_r();
+    ~Handle() { GEOS_finish_r(h); }
+  } handle;
+  return handle.h;
+}
+
+#if GEOS_VERSION_MAJOR > 3 || (GEOS_VERSION_MAJOR == 3 && GEOS_VERSION_MINOR >= 10)
+#define GROUNDPLAN_GEOS_BUFFERS 1  // GEOSCoordSeq_copyToBuffer_r / copyFromBuffer_r: one call per ring
+static_assert(sizeof(Point2) == 2 * sizeof(double), "a Ring is an array of x, y doubles");
+#endif
+
 void geos_ring(GEOSContextHandle_t h, const GEOSGeometry* ring, Ring& out) {
   const GEOSCoordSequence* seq = GEOSGeom_getCoordSeq_r(h, ring);
   unsigned int n = 0;
   if (!seq || !GEOSCoordSeq_getSize_r(h, seq, &n)) throw WkbError{"unreadable GEOS ring", false};
   out.resize(n);
+#ifdef GROUNDPLAN_GEOS_BUFFERS
+  if (n && !GEOSCoordSeq_copyToBuffer_r(h, seq, &out[0].x, 0, 0)) throw WkbError{"unreadable GEOS ring", false};
+#else
   for (unsigned int i = 0; i < n; ++i) GEOSCoordSeq_getXY_r(h, seq, i, &out[i].x, &out[i].y);
+#endif
   if (out.size() > 1 && out.front() == out.back()) out.pop_back();
 }
 
@@ -221,6 +276,104 @@ void geos_geometry(GEOSContextHandle_t h, const GEOSGeometry* g, std::vector<Pol
                        " is not a polygon or multipolygon",
                    true};
   }
+}
+
+// GEOS geometries out (Shapely 1.8's fast path, the same condition as the way in): the plans made as GEOS
+// polygons here, in parallel, and handed to Python as addresses; Shapely's Polygon objects then own them
+// (groundplan/__init__.py). Until that hand-over they belong to a GeosPlans, which destroys what is left.
+
+class GeosPlans {
+ public:
+  GeosPlans() = default;
+  GeosPlans(GeosPlans&& o) noexcept : g_(std::move(o.g_)) { o.g_.clear(); }
+  GeosPlans& operator=(GeosPlans&&) = delete;
+  ~GeosPlans() {
+    for (GEOSGeometry* g : g_)
+      if (g) GEOSGeom_destroy_r(geos_handle(), g);
+  }
+  void resize(std::size_t n) { g_.assign(n, nullptr); }
+  std::size_t size() const { return g_.size(); }
+  GEOSGeometry*& operator[](std::size_t i) { return g_[i]; }
+  /// Gives up geometry i: the caller owns it now.
+  std::uintptr_t release(std::size_t i) { return reinterpret_cast<std::uintptr_t>(std::exchange(g_[i], nullptr)); }
+
+ private:
+  std::vector<GEOSGeometry*> g_;
+};
+
+/// A ring of a plan as a closed GEOS LinearRing (nullptr where GEOS refuses it).
+GEOSGeometry* geos_linear_ring(GEOSContextHandle_t h, const Ring& r, std::vector<double>& buf) {
+  const std::size_t n = r.size() + 1;
+  GEOSCoordSequence* seq = nullptr;
+#ifdef GROUNDPLAN_GEOS_BUFFERS
+  buf.resize(2 * n);
+  if (!r.empty()) std::memcpy(buf.data(), r.data(), r.size() * sizeof(Point2));
+  buf[2 * n - 2] = r.empty() ? 0 : r[0].x;
+  buf[2 * n - 1] = r.empty() ? 0 : r[0].y;
+  seq = GEOSCoordSeq_copyFromBuffer_r(h, buf.data(), static_cast<unsigned int>(n), 0, 0);
+#else
+  (void)buf;
+  seq = GEOSCoordSeq_create_r(h, static_cast<unsigned int>(n), 2);
+  for (std::size_t i = 0; seq && i < n; ++i) GEOSCoordSeq_setXY_r(h, seq, static_cast<unsigned int>(i), r[i % r.size()].x, r[i % r.size()].y);
+#endif
+  return seq ? GEOSGeom_createLinearRing_r(h, seq) : nullptr;  // takes the sequence
+}
+
+/// A plan as a GEOS Polygon with the coordinates polygon_wkb writes (rings closed by their first point).
+GEOSGeometry* geos_polygon(GEOSContextHandle_t h, const Polygon& poly) {
+  if (poly.outer.empty()) return GEOSGeom_createEmptyPolygon_r(h);
+  thread_local std::vector<double> buf;
+  GEOSGeometry* shell = geos_linear_ring(h, poly.outer, buf);
+  if (!shell) return nullptr;
+  std::vector<GEOSGeometry*> holes(poly.holes.size(), nullptr);
+  bool ok = true;
+  for (std::size_t k = 0; k < holes.size() && ok; ++k) ok = (holes[k] = geos_linear_ring(h, poly.holes[k], buf)) != nullptr;
+  if (!ok) {
+    GEOSGeom_destroy_r(h, shell);
+    for (GEOSGeometry* g : holes)
+      if (g) GEOSGeom_destroy_r(h, g);
+    return nullptr;
+  }
+  return GEOSGeom_createPolygon_r(h, shell, holes.data(), static_cast<unsigned int>(holes.size()));  // takes the rings
+}
+
+/// Shapely 2 objects owning the GEOS polygons at `addresses`, made by Shapely's own C API (the capsule
+/// "shapely.lib._C_API" of shapely/src/c_api.h; entry 0: PyObject* CreateGeometry(GEOSGeometry*, context)).
+/// Only for a Shapely whose libgeos_c is this module's (the wrapper checks). On failure the geometries not
+/// yet taken over are freed. GIL held.
+py::list shapely2_geometries(const std::vector<std::uintptr_t>& addresses) {
+  std::size_t i = 0;
+  auto free_rest = [&] {
+    for (std::size_t k = i; k < addresses.size(); ++k)
+      if (addresses[k]) GEOSGeom_destroy_r(geos_handle(), reinterpret_cast<GEOSGeometry*>(addresses[k]));
+  };
+  void** api = static_cast<void**>(PyCapsule_Import("shapely.lib._C_API", 0));
+  if (!api) {
+    free_rest();
+    throw py::error_already_set();
+  }
+  using Create = PyObject* (*)(GEOSGeometry*, GEOSContextHandle_t);
+  const auto create = reinterpret_cast<Create>(api[0]);
+  py::list out(addresses.size());
+  for (; i < addresses.size(); ++i) {
+    PyObject* o = create(reinterpret_cast<GEOSGeometry*>(addresses[i]), geos_handle());
+    if (!o) {  // Shapely did not take this one over
+      free_rest();
+      throw py::error_already_set();
+    }
+    PyList_SET_ITEM(out.ptr(), static_cast<Py_ssize_t>(i), o);  // steals the reference
+  }
+  return out;
+}
+
+/// The address of GEOSversion as the shared object `path` (already loaded) binds it: the libgeos_c that
+/// Shapely 2's extension uses, to compare with this module's.
+std::uintptr_t geos_version_address_in(const std::string& path) {
+  void* h = dlopen(path.c_str(), RTLD_LAZY | RTLD_NOLOAD);
+  if (!h) return 0;
+  void* sym = dlsym(h, "GEOSversion");
+  dlclose(h);
+  return reinterpret_cast<std::uintptr_t>(sym);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -353,9 +506,11 @@ py::dict problem_dict(const Problem& p, bool with_index) {
 
 using ReadOne = std::function<void(std::size_t, std::vector<Polygon>&)>;  // throws WkbError
 
-py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, double resolution, const std::string& device, double snap,
-                   double close_gaps, double simplify, double min_hole_area, double min_area,
-                   const py::object& progress) {
+/// The union of n inputs read by read_one; the plans as WKB bytes, or (geos_out) as the addresses of GEOS
+/// polygons that the caller must own (groundplan/__init__.py wraps them in Shapely objects at once).
+py::dict union_inputs(std::size_t n, const ReadOne& read_one, bool geos_out, int threads, double resolution,
+                      const std::string& device, double snap, double close_gaps, double simplify, double min_hole_area,
+                      double min_area, const py::object& progress) {
   if (threads < 0) throw InvalidArgument("threads: " + std::to_string(threads) + " is not >= 1 (0 = all cores)");
   for (double v : {resolution, snap, close_gaps, simplify, min_hole_area, min_area})
     if (!(v >= 0) || !std::isfinite(v))
@@ -375,7 +530,10 @@ py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, doubl
     std::vector<GroundPlan> plans;
     std::vector<Problem> problems;
     std::vector<std::string> plan_wkb;
+    GeosPlans plan_geos;
     double parse_s = 0, union_s = 0, write_s = 0;
+    double parse_cpu_s = 0, union_cpu_s = 0, write_cpu_s = 0, alloc_s = 0;
+    long parse_faults = 0, union_faults = 0;
   };
   Out out = run_cancellable<Out>(
       [&](const Progress& prog) {
@@ -384,7 +542,13 @@ py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, doubl
         tbb::task_arena arena(arena_threads);
         arena.execute([&] {
           auto t0 = std::chrono::steady_clock::now();
-          std::vector<Footprint> fps(n);
+          double c0 = process_cpu_s();
+          long f0 = minor_faults();
+          std::vector<Footprint> fps;
+          fps.reserve(n);
+          advise_huge_pages(fps.data(), n * sizeof(Footprint));
+          fps.resize(n);
+          o.alloc_s = seconds_since(t0);
           std::vector<std::optional<WkbError>> errors(n);
           tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -403,25 +567,47 @@ py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, doubl
               throw InvalidArgument(what);
             }
           o.parse_s = seconds_since(t0);
+          o.parse_cpu_s = process_cpu_s() - c0;
+          o.parse_faults = minor_faults() - f0;
+          f0 = minor_faults();
           t0 = std::chrono::steady_clock::now();
+          c0 = process_cpu_s();
           o.plans = build_ground_plans(fps, up, lod, o.problems, prog);
           o.union_s = seconds_since(t0);
+          o.union_cpu_s = process_cpu_s() - c0;
+          o.union_faults = minor_faults() - f0;
           t0 = std::chrono::steady_clock::now();
-          o.plan_wkb.resize(o.plans.size());
-          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, o.plans.size(), 64),
-                            [&](const tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t i = r.begin(); i != r.end(); ++i) o.plan_wkb[i] = polygon_wkb(o.plans[i].polygon);
-                            });
+          c0 = process_cpu_s();
+          if (geos_out) {
+            o.plan_geos.resize(o.plans.size());
+            std::atomic<std::size_t> failed{o.plans.size()};
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, o.plans.size(), 64),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                const GEOSContextHandle_t h = geos_handle();
+                                for (std::size_t i = r.begin(); i != r.end(); ++i)
+                                  if (!(o.plan_geos[i] = geos_polygon(h, o.plans[i].polygon))) failed = i;
+                              });
+            if (failed != o.plans.size())
+              throw Error("GEOS refused plan " + std::to_string(failed.load()) + " as a polygon");
+          } else {
+            o.plan_wkb.resize(o.plans.size());
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, o.plans.size(), 64),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                for (std::size_t i = r.begin(); i != r.end(); ++i) o.plan_wkb[i] = polygon_wkb(o.plans[i].polygon);
+                              });
+          }
           o.write_s = seconds_since(t0);
+          o.write_cpu_s = process_cpu_s() - c0;
         });
         return o;
       },
       progress);
 
   const auto t0 = std::chrono::steady_clock::now();
+  const double c0 = process_cpu_s();
   py::list plans(out.plans.size()), members(out.plans.size()), areas(out.plans.size());
   for (std::size_t i = 0; i < out.plans.size(); ++i) {
-    plans[i] = py::bytes(out.plan_wkb[i]);
+    plans[i] = geos_out ? py::object(py::int_(out.plan_geos.release(i))) : py::object(py::bytes(out.plan_wkb[i]));
     const auto& m = out.plans[i].members;
     py::list ml(m.size());
     for (std::size_t k = 0; k < m.size(); ++k) ml[k] = py::int_(m[k]);
@@ -435,6 +621,13 @@ py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, doubl
   timings["union_s"] = out.union_s;
   timings["write_s"] = out.write_s;
   timings["to_python_s"] = seconds_since(t0);
+  timings["parse_cpu_s"] = out.parse_cpu_s;
+  timings["union_cpu_s"] = out.union_cpu_s;
+  timings["write_cpu_s"] = out.write_cpu_s;
+  timings["to_python_cpu_s"] = process_cpu_s() - c0;
+  timings["parse_alloc_s"] = out.alloc_s;  // of parse_s: the vector of footprints
+  timings["parse_minor_faults"] = out.parse_faults;
+  timings["union_minor_faults"] = out.union_faults;
   py::dict r;
   r["plans"] = plans;
   r["members"] = members;
@@ -445,9 +638,9 @@ py::dict union_inputs(std::size_t n, const ReadOne& read_one, int threads, doubl
 }
 
 #define GROUNDPLAN_UNION_PARAMS                                                                                \
-  int threads, double resolution, const std::string &device, double snap, double close_gaps, double simplify, \
+  bool geos_out, int threads, double resolution, const std::string &device, double snap, double close_gaps, double simplify, \
       double min_hole_area, double min_area, const py::object &progress
-#define GROUNDPLAN_UNION_ARGS threads, resolution, device, snap, close_gaps, simplify, min_hole_area, min_area, progress
+#define GROUNDPLAN_UNION_ARGS geos_out, threads, resolution, device, snap, close_gaps, simplify, min_hole_area, min_area, progress
 
 py::dict union_wkb(const py::list& wkbs, GROUNDPLAN_UNION_PARAMS) {
   // The bytes objects stay alive in `wkbs` (held by the caller) while the worker reads them.
@@ -471,11 +664,7 @@ py::dict union_geos(const std::vector<std::uintptr_t>& addresses, GROUNDPLAN_UNI
   return union_inputs(
       addresses.size(),
       [&](std::size_t i, std::vector<Polygon>& out) {
-        thread_local struct Handle {
-          GEOSContextHandle_t h = GEOS_init_r();
-          ~Handle() { GEOS_finish_r(h); }
-        } handle;
-        geos_geometry(handle.h, reinterpret_cast<const GEOSGeometry*>(addresses[i]), out, 0);
+        geos_geometry(geos_handle(), reinterpret_cast<const GEOSGeometry*>(addresses[i]), out, 0);
       },
       GROUNDPLAN_UNION_ARGS);
 }
@@ -579,16 +768,28 @@ PYBIND11_MODULE(_groundplan, m) {
       PyErr_SetString(PyExc_RuntimeError, e.what());
     }
   });
-  m.def("union_wkb", &union_wkb, py::arg("wkbs"), py::arg("threads"), py::arg("resolution"), py::arg("device"),
+  m.def("union_wkb", &union_wkb, py::arg("wkbs"), py::arg("geos_out") = false, py::arg("threads"), py::arg("resolution"), py::arg("device"),
         py::arg("snap"), py::arg("close_gaps"), py::arg("simplify"), py::arg("min_hole_area"), py::arg("min_area"),
         py::arg("progress"),
-        "union_wkb(wkbs: list[bytes], ...) -> dict(plans=[WKB], members=[[int]], areas=[float], problems=[dict], timings=dict)");
-  m.def("union_geos", &union_geos, py::arg("addresses"), py::arg("threads"), py::arg("resolution"), py::arg("device"),
+        "union_wkb(wkbs: list[bytes], ...) -> dict(plans=[WKB], members=[[int]], areas=[float], problems=[dict], timings=dict);\n"
+        "geos_out=True: plans are the addresses of GEOS polygons of this module's libgeos_c, owned by the caller");
+  m.def("union_geos", &union_geos, py::arg("addresses"), py::arg("geos_out") = false, py::arg("threads"), py::arg("resolution"), py::arg("device"),
         py::arg("snap"), py::arg("close_gaps"), py::arg("simplify"), py::arg("min_hole_area"), py::arg("min_area"),
         py::arg("progress"),
         "union_geos(addresses: list[int], ...): as union_wkb, from the addresses of GEOS geometries of the same libgeos_c");
   m.def("geos_version_address", [] { return reinterpret_cast<std::uintptr_t>(&GEOSversion); },
         "The address of GEOSversion in the libgeos_c this module uses (Shapely's must be the same for union_geos)");
+  m.def(
+      "destroy_geos",
+      [](const std::vector<std::uintptr_t>& addresses) {
+        for (std::uintptr_t a : addresses)
+          if (a) GEOSGeom_destroy_r(geos_handle(), reinterpret_cast<GEOSGeometry*>(a));
+      },
+      py::arg("addresses"), "Frees GEOS geometries given by union_*(geos_out=True) that no Shapely object took over");
+  m.def("shapely2_geometries", &shapely2_geometries, py::arg("addresses"),
+        "Shapely 2 objects owning the GEOS polygons given by union_*(geos_out=True), made by Shapely's C API");
+  m.def("geos_version_address_in", &geos_version_address_in, py::arg("path"),
+        "The address of GEOSversion that the loaded shared object `path` binds (0 if not loaded)");
   m.def("read", &read_inputs, py::arg("inputs"), py::arg("options"), py::arg("progress"),
         "read(inputs: list[str], options: dict[str, str], progress) -> dict(layers=..., crs_wkt=..., crs_name=..., stats=...)");
 }

@@ -53,9 +53,11 @@ def test_generated_city_equals_unary_union(route):
     assert r.problems == []
     import shapely
 
-    if route == "wkb" or shapely.__version__ >= "2":
+    if shapely.__version__ < "2":
+        assert groundplan._shares_geos()  # Debian's Shapely 1.8 shares this module's libgeos_c
+    if route == "wkb" or not groundplan._shares_geos():  # (a Shapely 2 wheel brings a libgeos_c of its own)
         assert r.timings["route"] == "wkb"
-    else:  # Debian's Shapely 1.8 shares this module's libgeos_c
+    else:
         assert r.timings["route"] == "geos"
     assert sum(r.areas) == pytest.approx(unary_union(geoms).area, rel=1e-9)
 
@@ -187,3 +189,91 @@ def test_help_shows_signature_and_docstring():
     sig = inspect.signature(groundplan.union)
     assert sig.parameters["threads"].kind is inspect.Parameter.KEYWORD_ONLY
     assert "UnionResult" in str(sig.return_annotation)
+
+
+def _wkb_route(monkeypatch):
+    monkeypatch.setattr(groundplan, "_geos_addresses", lambda geoms: None)
+
+
+def test_geos_route_plans_equal_the_wkb_route_exactly(monkeypatch):
+    """The plans made as GEOS polygons in C++ (wrapped by Shapely 1.8's classes, or by Shapely 2's C API)
+    have the very coordinates of the WKB route's."""
+    if not groundplan._shares_geos():
+        pytest.skip("this Shapely has a libgeos_c of its own: the WKB route only")
+    geoms = block_city(3000, seed=7) + [Polygon([(0, 0), (20, 0), (20, 20), (0, 20)], [[(5, 5), (15, 5), (15, 15), (5, 15)]])]
+    a = groundplan.union(geoms)
+    assert a.timings["route"] == "geos"
+    _wkb_route(monkeypatch)
+    b = groundplan.union(geoms)
+    assert b.timings["route"] == "wkb"
+    assert a.members == b.members
+    assert [p.wkb for p in a.plans] == [p.wkb for p in b.plans]
+    assert any(len(p.interiors) for p in a.plans)
+    assert all(type(p) is Polygon and p.is_valid and not p.is_empty and not p.has_z for p in a.plans)
+
+
+def test_geos_route_plans_own_their_geometries(monkeypatch):
+    """Each plan's GEOS polygon is freed (once) by Shapely when the plan goes, and only then."""
+    import gc
+
+    import shapely
+
+    if shapely.__version__ >= "2":
+        pytest.skip("Shapely 1.x's wrapping (Shapely 2's C API frees what it did not take over itself)")
+    from shapely.geometry.base import BaseGeometry
+
+    r = groundplan.union(city(300, seed=3))
+    assert r.timings["route"] == "geos"
+    addresses = [p.__geom__ for p in r.plans]
+    assert len(set(addresses)) == len(addresses) and all(addresses)
+    freed = []
+    real = BaseGeometry._lgeos
+
+    class Recorder:
+        def __getattr__(self, name):
+            return getattr(real, name)
+
+        def GEOSGeom_destroy(self, g):
+            freed.append(g)
+            real.GEOSGeom_destroy(g)
+
+    monkeypatch.setattr(BaseGeometry, "_lgeos", Recorder())
+    plans = r.plans
+    del r
+    gc.collect()
+    assert freed == []  # still held by `plans`
+    del plans
+    gc.collect()
+    assert sorted(freed) == sorted(addresses)
+
+
+def test_geos_route_frees_what_no_plan_took(monkeypatch):
+    """A failure while the plans become Shapely objects frees the GEOS polygons not yet taken over."""
+    import shapely
+
+    if shapely.__version__ >= "2":
+        pytest.skip("Shapely 1.x's wrapping (Shapely 2's C API frees what it did not take over itself)")
+    made, destroyed = [], []
+    real_destroy = groundplan._groundplan.destroy_geos
+    real_make = groundplan._shapely1_polygon_maker()
+
+    def maker():
+        def make(address):
+            if len(made) == 2:
+                raise MemoryError("made to fail")
+            made.append(address)
+            return real_make(address)
+
+        return make
+
+    def destroy(addresses):
+        destroyed.extend(addresses)
+        real_destroy(addresses)
+
+    monkeypatch.setattr(groundplan, "_shapely1_polygon_maker", maker)
+    monkeypatch.setattr(groundplan._groundplan, "destroy_geos", destroy)
+    geoms = [Polygon([(10 * i, 0), (10 * i + 5, 0), (10 * i + 5, 5)]) for i in range(6)]
+    with pytest.raises(MemoryError):
+        groundplan.union(geoms)
+    assert len(made) == 2 and len(destroyed) == 4
+    assert not set(made) & set(destroyed)
