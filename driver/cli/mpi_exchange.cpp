@@ -51,7 +51,10 @@ MpiExchange::MpiExchange(int* argc, char*** argv) {
 
 MpiExchange::~MpiExchange() { MPI_Finalize(); }
 
-void MpiExchange::barrier() { check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier"); }
+void MpiExchange::barrier() {
+  test_failure(true);
+  check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
+}
 
 void MpiExchange::abort(const std::string& why, int code) {
   std::fprintf(stderr, "groundplan: rank %d of %d: %s; aborting every rank of the run (nothing is written)\n", rank_,
@@ -62,12 +65,16 @@ void MpiExchange::abort(const std::string& why, int code) {
 }
 
 // A test hook (tests/e2e/test_mpi.py): GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW makes rank RANK fail at its second
-// exchange (after the map): HOW = throw (an exception, as a failing rank) or kill (SIGKILL, as a dead one).
-void MpiExchange::test_failure() {
-  if (++calls_ != 2) return;
+// allgather (after the map), or with HOW ending in "@end" at the final barrier (rank 0 has written then):
+// HOW = throw (an exception, as a failing rank) or kill (SIGKILL, as a dead one).
+void MpiExchange::test_failure(bool at_end) {
+  if (!at_end && ++calls_ != 2) return;
   const char* v = std::getenv("GROUNDPLAN_MPI_TEST_FAIL");
   if (!v) return;
-  const std::string s(v);
+  std::string s(v);
+  const bool end = s.size() > 4 && s.compare(s.size() - 4, 4, "@end") == 0;
+  if (end != at_end) return;
+  if (end) s.resize(s.size() - 4);
   const std::size_t colon = s.find(':');
   if (colon == std::string::npos || std::atoi(s.substr(0, colon).c_str()) != rank_) return;
   if (s.substr(colon + 1) == "kill") ::raise(SIGKILL);
@@ -75,7 +82,7 @@ void MpiExchange::test_failure() {
 }
 
 std::vector<char> MpiExchange::allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes) {
-  test_failure();
+  test_failure(false);
   if (mine.size() > static_cast<std::size_t>(1) << 30) throw Error("MPI allgather: a part over 1 GiB");
   int n = static_cast<int>(mine.size());
   std::vector<int> counts(static_cast<std::size_t>(size_));

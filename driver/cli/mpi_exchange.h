@@ -29,7 +29,7 @@ class MpiExchange final : public gis::TileExchange {
  private:
   int rank_ = 0, size_ = 1;
   int calls_ = 0;  // for GROUNDPLAN_MPI_TEST_FAIL
-  void test_failure();
+  void test_failure(bool at_end);
 };
 
 /// True when this process was started by Open MPI's mpirun (its environment says so).

@@ -128,21 +128,30 @@ def test_a_bad_tile_is_a_problem_and_the_run_completes(tmp_path):
     check_plans(got, got[3], 3, 5)
 
 
-@pytest.mark.parametrize("how", ["throw", "kill"])
+@pytest.mark.parametrize("how", ["throw", "kill", "throw@end", "kill@end"])
 def test_a_rank_that_dies_aborts_the_run_and_writes_nothing(tmp_path, city, how):
+    """Rank 2 fails after the map, or rank 0 at the final barrier, when it has written (@end): non-zero exit, a
+    message, and no dataset under the name asked for (rank 0 writes into a hidden staging folder moved into place
+    after the barrier: removed when it throws, left when it is killed, never out.gpkg)."""
     folder, _ = city
     out = tmp_path / "out.gpkg"
     env = gdal_env()
-    env["GROUNDPLAN_MPI_TEST_FAIL"] = f"2:{how}"
+    rank = 0 if how.endswith("@end") else 2
+    env["GROUNDPLAN_MPI_TEST_FAIL"] = f"{rank}:{how}"
     p = subprocess.run([*mpirun(4), "-x", "GROUNDPLAN_MPI_TEST_FAIL", BIN, "-q", "--tiles", "on", "--id-field", "bid",
                         "-f", "GPKG", str(out), str(folder)], capture_output=True, text=True, env=env, timeout=300)
     assert p.returncode != 0
-    if how == "throw":
-        assert "rank 2 of 4: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr and "aborting every rank" in p.stderr, p.stderr
+    if how.startswith("throw"):
+        assert f"rank {rank} of 4: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr and "aborting every rank" in p.stderr, p.stderr
     else:
-        assert "rank 2" in p.stderr and "signal 9" in p.stderr, p.stderr
+        assert f"rank {rank}" in p.stderr and "signal 9" in p.stderr, p.stderr
     assert not out.exists()
-    assert os.listdir(tmp_path) == []
+    left = os.listdir(tmp_path)
+    if how == "kill@end":  # killed with the dataset written in the staging folder: that folder is all there is
+        assert len(left) == 1 and left[0].startswith(".groundplan-partial-"), left
+        assert os.listdir(tmp_path / left[0]) == ["out.gpkg"]
+    else:
+        assert left == []
 
 
 def test_what_the_tiled_run_cannot_do_is_refused_over_ranks(tmp_path, city):
