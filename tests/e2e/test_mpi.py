@@ -120,9 +120,12 @@ def test_a_bad_tile_is_a_problem_and_the_run_completes(tmp_path):
     folder.mkdir()
     for tile in sorted(NIEDERSACHSEN.glob("*.gml")):
         (folder / tile.name).symlink_to(tile)
-    (folder / "LoD1_24075861_broken.gml").write_text('<?xml version="1.0"?>\n<CityModel><cityObjectMember><bldg')
+    # last by name: the last rank's only tile, so its problem has to travel to rank 0
+    bad = '<?xml version="1.0"?>\n<CityModel><cityObjectMember><bldg'
+    (folder / "LoD1_99999999_broken.gml").write_text(bad)
     one = outputs(tmp_path, "one", folder, "--tiles", "off")
     got = outputs(tmp_path, "mpi", folder, "--tiles", "on", launcher=mpirun(3))
+    assert got[3]["mpi"]["per_rank"][2]["bytes"] == len(bad)
     assert got[0] == one[0] and got[1] == one[1] and got[2] == one[2]
     assert [p for p in got[2] if p[2] == "UNREADABLE_FILE"], got[2]
     check_plans(got, got[3], 3, 5)
