@@ -8,8 +8,9 @@
 # The bundle: the CLI packed with Open MPI (mpirun = orterun, orted, plugins), from the repository root:
 #   PACK_MPI=1 tests/gpu/pack_cli.sh build /tmp/gp-mpi.tar.xz
 #   tests/bench/mpi_on_device.sh /tmp/gp-mpi.tar.xz [TX TY K] [RANKS...]
-# Open MPI is relocated with OPAL_PREFIX (its Debian layout is kept under gp/ompi); if mpirun cannot start there,
-# the script says so and stops.
+# Open MPI is relocated with OPAL_PREFIX (its Debian layout is kept under gp/ompi; checked on the 2-core VM with
+# Debian's own Open MPI folders hidden by tmpfs mounts in `unshare -m`: 3 ranks ran from the bundle alone); if
+# mpirun cannot start there, the script says so and stops.
 set -u
 BUNDLE=${1:?BUNDLE}; TX=${2:-8}; TY=${3:-8}; K=${4:-8}; shift $(( $# < 4 ? $# : 4 ))
 RANKS=${*:-1 2 4 8 16}
