@@ -507,6 +507,8 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
     return finish(1);
   }
   if (!w.members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", w.members_note.c_str());
+  // Over ranks the dataset is in place only now: "wrote" is said after that.
+  const int rc = finish(stats(w.write_s, w.index_s, w.own_index ? &w.built : nullptr) ? 0 : 1);
   if (!ogr.quiet) {
     const groundplan::gis::TileStats& t = r.tiles;
     std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles%s\n", r.buildings_read, ogr.src.c_str(),
@@ -520,7 +522,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
                 seconds_since(t0), t.map_s, t.reduce_s, w.write_s);
     print_problems(r.problems);
   }
-  return finish(stats(w.write_s, w.index_s, w.own_index ? &w.built : nullptr) ? 0 : 1);
+  return rc;
 }
 
 int run(int argc, char** argv, Ranks* ranks) {
