@@ -32,6 +32,9 @@ packages=(
   # QGIS as a client (issue 18, qgis/ and tests/e2e/test_qgis*.py): PyQGIS and the OGR provider to load and
   # render the driver's layers, qgis for qgis_process (runs the Processing algorithm), xvfb for headless runs
   python3-qgis qgis-providers qgis xvfb
+  # MPI (issue 15, GROUNDPLAN_MPI=AUTO|ON|OFF): `mpirun -np N groundplan ...` spreads the tiled run over
+  # ranks, tests/e2e/test_mpi.py runs it; Open MPI is the MPI CMake's AUTO looks for
+  openmpi-bin libopenmpi-dev
   # fuzzing (libFuzzer with clang; tests/fuzz) and the sanitizer runtime's symbolizer
   clang libclang-rt-14-dev llvm
 )

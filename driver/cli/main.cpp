@@ -6,6 +6,10 @@
 #include "open_options.h"
 #include "gpkg_rtree.h"
 #include "preview.h"
+#ifdef GROUNDPLAN_WITH_MPI
+#include "mpi_exchange.h"
+#include "staged_output.h"
+#endif
 
 #include <groundplan/error.h>
 #include <groundplan/gis/geos_reference.h>
@@ -29,9 +33,27 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace {
+
+#ifdef GROUNDPLAN_WITH_MPI
+using Ranks = groundplan::cli::MpiExchange;
+#else
+/// Without MPI there is one rank and no exchange (nullptr everywhere).
+class Ranks {};
+#endif
+
+/// Ranks of the run: more than one only under `mpirun -np N` with N > 1 (an MPI build).
+int rank_count(Ranks* ranks) {
+#ifdef GROUNDPLAN_WITH_MPI
+  return ranks ? ranks->size() : 1;
+#else
+  (void)ranks;
+  return 1;
+#endif
+}
 
 using groundplan::gis::PipelineOptions;
 using groundplan::gis::PipelineResult;
@@ -399,11 +421,37 @@ std::string tiles_ruled_out(const PipelineOptions& options, const Ogr2ogrArgs& o
 
 /// The tiled run (issue 15, gis/tiled.h): same plans with bounded memory; the final plans of all tiles first,
 /// then the plans from seams. --stats says how many were final at once and how many were seams.
-int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std::string& stats_path,
-              const groundplan::Progress& progress) {
+int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const std::string& stats_path,
+              const groundplan::Progress& progress, Ranks* ranks) {
   const double cpu0 = groundplan::gis::process_cpu_seconds();
   const auto t0 = clock::now();
-  std::shared_ptr<const groundplan::gis::TiledResult> result = groundplan::gis::run_pipeline_tiled(options, progress);
+  std::shared_ptr<const groundplan::gis::TiledResult> result;
+  Ogr2ogrArgs ogr = ogr_in;
+#ifdef GROUNDPLAN_WITH_MPI
+  // Over ranks (issue 15): rank 0 gets every plan and writes the one dataset, into a staging folder that is moved
+  // into place once every rank has finished (staged_output.h); the others only map and reduce.
+  std::unique_ptr<groundplan::cli::StagedOutput> staged;
+  if (rank_count(ranks) > 1) {
+    result = groundplan::gis::run_pipeline_tiled(options, *ranks, ranks->rank() == 0 ? progress : groundplan::Progress{});
+    if (ranks->rank() != 0) {
+      ranks->barrier();  // rank 0 has written
+      return 0;
+    }
+    staged = std::make_unique<groundplan::cli::StagedOutput>(ogr.dst);
+    ogr.dst = staged->path();
+  }
+  // Every rank waits for rank 0 here before the dataset is moved into place; rank 0's outcome is its return code.
+  auto finish = [&](int rc) {
+    if (rank_count(ranks) > 1) {
+      ranks->barrier();
+      if (rc == 0) staged->commit();
+    }
+    return rc;
+  };
+#else
+  auto finish = [](int rc) { return rc; };
+#endif
+  if (!result) result = groundplan::gis::run_pipeline_tiled(options, progress);
   const groundplan::gis::TiledResult& r = *result;
   auto stats = [&](double write_s, double index_s, const groundplan::cli::RtreeBuild* index) {
     if (stats_path.empty()) return true;
@@ -421,6 +469,18 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std:
                   {"plans_from_seams", t.reduced_plans}, {"max_tile_footprints", t.max_tile_footprints},
                   {"tiles_in_flight", t.tiles_in_flight}, {"spill_bytes", t.spill_bytes},
                   {"map_s", t.map_s}, {"reduce_s", t.reduce_s}};
+    if (r.ranks.size() > 1) {  // the run over MPI ranks: each rank's share
+      nlohmann::json per_rank = nlohmann::json::array();
+      for (const groundplan::gis::RankStats& s : r.ranks)
+        per_rank.push_back({{"tiles", s.tiles}, {"bytes", s.bytes}, {"footprints", s.footprints},
+                            {"seam_footprints_united", s.seam_footprints}, {"map_s", s.map_s},
+                            {"reduce_s", s.reduce_s}, {"gather_s", s.gather_s}, {"cpu_s", s.cpu_s},
+                            {"peak_rss_bytes", s.peak_rss_bytes}});
+      rusage u{};
+      getrusage(RUSAGE_SELF, &u);
+      j["mpi"] = {{"ranks", r.ranks.size()}, {"reduce_rounds", t.reduce_rounds}, {"per_rank", per_rank},
+                  {"rank0_peak_rss_after_write_bytes", static_cast<std::uint64_t>(u.ru_maxrss) * 1024}};
+    }
     j["raster_backend"] = r.raster_backend;
     if (index)
       j["spatial_index"] = spatial_index_json(*index);
@@ -436,33 +496,36 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std:
                      ? "no building found"
                      : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
     stats(0, 0, nullptr);
-    return 1;
+    return finish(1);
   }
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
                                                              result, writes_dbf(ogr) ? 254 : 0, options.threads);
   const WriteOutcome w = write_output(ds, ogr, options.threads);
   if (!w.ok) {
-    std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr.dst.c_str(),
+    std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr_in.dst.c_str(),
                  w.usage_error ? " (bad ogr2ogr options)" : "");
-    return 1;
+    return finish(1);
   }
   if (!w.members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", w.members_note.c_str());
+  // Over ranks the dataset is in place only now: "wrote" is said after that.
+  const int rc = finish(stats(w.write_s, w.index_s, w.own_index ? &w.built : nullptr) ? 0 : 1);
   if (!ogr.quiet) {
     const groundplan::gis::TileStats& t = r.tiles;
-    std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles\n", r.buildings_read, ogr.src.c_str(),
-                r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles);
+    std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles%s\n", r.buildings_read, ogr.src.c_str(),
+                r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles,
+                r.ranks.size() > 1 ? (" on " + std::to_string(r.ranks.size()) + " MPI ranks").c_str() : "");
     std::printf("groundplan: %zu footprints -> %zu ground plans (%zu final at once, %zu from %zu seam plans of "
                 "%zu footprints); %zu problems\n",
                 r.footprints, r.plan_count(), t.final_plans, t.reduced_plans, t.seam_plans, t.seam_footprints,
                 count_defects(r.problems));
-    std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", ogr.dst.c_str(),
+    std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", ogr_in.dst.c_str(),
                 seconds_since(t0), t.map_s, t.reduce_s, w.write_s);
     print_problems(r.problems);
   }
-  return stats(w.write_s, w.index_s, w.own_index ? &w.built : nullptr) ? 0 : 1;
+  return rc;
 }
 
-int run(int argc, char** argv) {
+int run(int argc, char** argv, Ranks* ranks) {
   CLI::App app{
       "groundplan: ground plans (the exact union of building footprints) from 3D city models.\n"
       "Usage: groundplan [groundplan options] [ogr2ogr options] dst_datasource src_file_or_folder [layer ...]\n"
@@ -472,7 +535,11 @@ int run(int argc, char** argv) {
       "groundplan"};
   app.allow_extras();
   app.set_version_flag("--version", std::string("groundplan ") + GROUNDPLAN_VERSION + " (GDAL " +
-                                        GDALVersionInfo("RELEASE_NAME") + ")");
+                                        GDALVersionInfo("RELEASE_NAME") +
+#ifdef GROUNDPLAN_WITH_MPI
+                                        ", MPI: " + groundplan::cli::mpi_version() +
+#endif
+                                        ")");
   double resolution = 0;
   std::string device = "auto", footprints = "auto", stats_path, preview_path, origin;
   std::string lod = "-1";
@@ -606,13 +673,20 @@ int run(int argc, char** argv) {
     throw groundplan::InvalidArgument("--tiles on: " + no_tiles + "; use --tiles off");
   bool tiled = tiles_mode == "on";
   if (tiles_mode == "auto" && no_tiles.empty()) tiled = tiles_pay_off(options.inputs);
+  if (rank_count(ranks) > 1) {  // mpirun -np N (N > 1): the ranks share the tiled run
+    if (tiles_mode == "off" || !no_tiles.empty())
+      throw groundplan::InvalidArgument("mpirun -np " + std::to_string(rank_count(ranks)) + ": the ranks share the "
+                                        "tiled run, and " + (no_tiles.empty() ? std::string("--tiles off") : no_tiles) +
+                                        "; run it without mpirun");
+    tiled = true;
+  }
   if (tiled) {
     groundplan::Progress tile_progress;
     if (ogr.progress && !ogr.quiet)
       tile_progress = groundplan::Progress([](double f, const char* msg) {
         return GDALTermProgress(f, msg, nullptr) != FALSE;
       });
-    return run_tiled(options, ogr, stats_path, tile_progress);
+    return run_tiled(options, ogr, stats_path, tile_progress, ranks);
   }
 
   const double cpu0 = groundplan::gis::process_cpu_seconds();
@@ -709,11 +783,20 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::unique_ptr<Ranks> ranks;
   try {
-    const int rc = run(argc, argv);
+#ifdef GROUNDPLAN_WITH_MPI
+    // Only under mpirun: a plain start never initialises MPI (and so behaves as the CLI without MPI).
+    if (groundplan::cli::launched_by_mpirun()) ranks = std::make_unique<Ranks>(&argc, &argv);
+#endif
+    const int rc = run(argc, argv, ranks.get());
     GDALDestroyDriverManager();
     return rc;
   } catch (const std::exception& e) {
+#ifdef GROUNDPLAN_WITH_MPI
+    // One rank failing ends them all: the others would wait for it forever.
+    if (ranks && ranks->size() > 1) ranks->abort(e.what());
+#endif
     std::fprintf(stderr, "groundplan: %s\n", e.what());
     return 1;
   }

@@ -33,11 +33,12 @@ def plan_key(wkt):
     return rings[0], tuple(sorted(rings[1:]))
 
 
-def outputs(tmp_path, name, src, *flags):
-    """Sorted plan, member and problem rows of a CSV run, and its --stats."""
+def outputs(tmp_path, name, src, *flags, launcher=()):
+    """Sorted plan, member and problem rows of a CSV run, and its --stats. `launcher`: e.g. mpirun and its
+    options (test_mpi.py)."""
     out = tmp_path / name
     stats = tmp_path / f"{name}.json"
-    run([BIN, "-q", "--threads", "2", "--stats", stats, *flags, "-f", "CSV", "-lco", "GEOMETRY=AS_WKT", out, src,
+    run([*launcher, BIN, "-q", "--threads", "2", "--stats", stats, *flags, "-f", "CSV", "-lco", "GEOMETRY=AS_WKT", out, src,
          "ground_plans", "plan_members", "problems"])
 
     def rows(layer):

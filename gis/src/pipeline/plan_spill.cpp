@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// PlanSpill: a flat binary record a tile plan, length-prefixed (u64), little-endian host layout: the file
-// lives only as long as the process that wrote it.
+// PlanSpill: a flat binary record a tile plan, length-prefixed (u64), host layout: the file lives only as long
+// as the process that wrote it, and the ranks of an MPI run (issue 15) that exchange records run on hosts of one
+// architecture.
 #include "pipeline/plan_spill.h"
 
 #include <groundplan/error.h>
@@ -135,11 +136,10 @@ PlanSpill::~PlanSpill() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-std::uint64_t PlanSpill::append(const GroundPlan& plan, const std::vector<const Footprint*>& members,
-                                std::uint32_t tile, const std::array<double, 4>& box) {
-  const std::uint64_t offset = size_;
-  const std::size_t start = buffer_.size();
-  Writer w(buffer_);
+void PlanSpill::encode(const GroundPlan& plan, const std::vector<const Footprint*>& members, std::uint32_t tile,
+                       const std::array<double, 4>& box, std::vector<char>& out) {
+  const std::size_t start = out.size();
+  Writer w(out);
   w.put(std::uint64_t{0});  // record length, filled below
   w.put(tile);
   for (double b : box) w.put(b);
@@ -157,11 +157,34 @@ std::uint64_t PlanSpill::append(const GroundPlan& plan, const std::vector<const 
     w.put(static_cast<std::uint32_t>(fp.polygons.size()));
     for (const Polygon& p : fp.polygons) w.polygon(p);
   }
-  const std::uint64_t length = buffer_.size() - start - sizeof(std::uint64_t);
-  std::memcpy(buffer_.data() + start, &length, sizeof length);
+  const std::uint64_t length = out.size() - start - sizeof(std::uint64_t);
+  std::memcpy(out.data() + start, &length, sizeof length);
+}
+
+std::uint64_t PlanSpill::append(const GroundPlan& plan, const std::vector<const Footprint*>& members,
+                                std::uint32_t tile, const std::array<double, 4>& box) {
+  const std::uint64_t offset = size_;
+  const std::size_t start = buffer_.size();
+  encode(plan, members, tile, box, buffer_);
   size_ += buffer_.size() - start;
   if (buffer_.size() >= kBufferBytes) flush();
   return offset;
+}
+
+std::uint64_t PlanSpill::append_encoded(const char* record, std::size_t n) {
+  const std::uint64_t offset = size_;
+  buffer_.insert(buffer_.end(), record, record + n);
+  size_ += n;
+  if (buffer_.size() >= kBufferBytes) flush();
+  return offset;
+}
+
+std::size_t PlanSpill::record_length(const char* p, std::size_t left) {
+  std::uint64_t length = 0;
+  if (left < sizeof length) throw Error("tiled run: plan record cut short (length)");
+  std::memcpy(&length, p, sizeof length);
+  if (length > left - sizeof length) throw Error("tiled run: plan record cut short");
+  return static_cast<std::size_t>(sizeof length + length);
 }
 
 void PlanSpill::flush() {
@@ -178,15 +201,9 @@ void PlanSpill::flush() {
   buffer_.clear();
 }
 
-SpilledPlan PlanSpill::read(std::uint64_t offset, bool polygons, std::uint64_t* next) const {
-  if (offset + sizeof(std::uint64_t) > written_) throw Error("tiled run: plan record past the end of the temporary file");
-  std::uint64_t length = 0;
-  read_fully(fd_, reinterpret_cast<char*>(&length), sizeof length, offset);
-  if (offset + sizeof length + length > written_) throw Error("tiled run: temporary plan file is corrupt (length)");
-  std::vector<char> bytes(length);
-  read_fully(fd_, bytes.data(), length, offset + sizeof length);
-  if (next) *next = offset + sizeof length + length;
-  Reader r(bytes.data(), bytes.size());
+namespace {
+
+SpilledPlan decode(Reader& r, bool polygons) {
   SpilledPlan s;
   s.tile = r.get<std::uint32_t>();
   for (double& b : s.box) b = r.get<double>();
@@ -209,9 +226,36 @@ SpilledPlan PlanSpill::read(std::uint64_t offset, bool polygons, std::uint64_t* 
       if (polygons) fp.polygons.push_back(std::move(poly));
     }
   }
-  if (!r.done()) throw Error("tiled run: temporary plan file is corrupt (record longer than its contents)");
   s.plan.members = s.ids;
   return s;
+}
+
+}  // namespace
+
+SpilledPlan PlanSpill::read(std::uint64_t offset, bool polygons, std::uint64_t* next) const {
+  if (offset + sizeof(std::uint64_t) > written_) throw Error("tiled run: plan record past the end of the temporary file");
+  std::uint64_t length = 0;
+  read_fully(fd_, reinterpret_cast<char*>(&length), sizeof length, offset);
+  if (offset + sizeof length + length > written_) throw Error("tiled run: temporary plan file is corrupt (length)");
+  std::vector<char> bytes(length);
+  read_fully(fd_, bytes.data(), length, offset + sizeof length);
+  if (next) *next = offset + sizeof length + length;
+  Reader r(bytes.data(), bytes.size());
+  SpilledPlan s = decode(r, polygons);
+  if (!r.done()) throw Error("tiled run: temporary plan file is corrupt (record longer than its contents)");
+  return s;
+}
+
+std::vector<SpilledPlan> PlanSpill::decode_all(const std::vector<char>& bytes, bool polygons) {
+  std::vector<SpilledPlan> out;
+  for (std::size_t at = 0; at < bytes.size();) {
+    const std::size_t n = record_length(bytes.data() + at, bytes.size() - at);
+    Reader r(bytes.data() + at + sizeof(std::uint64_t), n - sizeof(std::uint64_t));
+    out.push_back(decode(r, polygons));
+    if (!r.done()) throw Error("tiled run: plan record longer than its contents");
+    at += n;
+  }
+  return out;
 }
 
 }  // namespace groundplan::gis::detail

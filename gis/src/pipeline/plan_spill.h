@@ -34,11 +34,21 @@ class PlanSpill {
   /// footprint of plan.members[k]). Returns the record's offset. Throws Error when the disk refuses.
   std::uint64_t append(const GroundPlan& plan, const std::vector<const Footprint*>& members, std::uint32_t tile,
                        const std::array<double, 4>& box);
+  /// Appends one record as encode() made it (length prefix included), e.g. one received from another rank.
+  /// Returns its offset.
+  std::uint64_t append_encoded(const char* record, std::size_t n);
   /// Writes what is buffered; call before reading.
   void flush();
   /// The record at `offset`; `next` (optional) gets the offset of the one after it. With `polygons` false the
   /// member footprints carry everything but their polygons. Throws Error on a short read.
   SpilledPlan read(std::uint64_t offset, bool polygons, std::uint64_t* next = nullptr) const;
+  /// The record append() writes (length prefix first), added to `out`: what ranks send each other.
+  static void encode(const GroundPlan& plan, const std::vector<const Footprint*>& members, std::uint32_t tile,
+                     const std::array<double, 4>& box, std::vector<char>& out);
+  /// The records in `bytes` (a run of encode()d records), decoded one by one. Throws Error when cut short.
+  static std::vector<SpilledPlan> decode_all(const std::vector<char>& bytes, bool polygons);
+  /// Length of the record starting at `p` (prefix included), checked against `left` bytes. Throws Error.
+  static std::size_t record_length(const char* p, std::size_t left);
   /// Offset past the last record (bytes written).
   std::uint64_t size() const { return size_; }
   const std::string& directory() const { return dir_; }

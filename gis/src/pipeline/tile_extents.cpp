@@ -65,16 +65,17 @@ void TileExtents::cell_range(const Box& b, std::int64_t& x0, std::int64_t& y0, s
   y1 = clamp((b[3] - all_[1]) / cell_, ny_);
 }
 
-bool TileExtents::meets_other(const Box& box, std::uint32_t own) const {
+bool TileExtents::meets_outside(const Box& box, std::uint32_t first, std::uint32_t last) const {
+  auto outside = [&](std::uint32_t t) { return t < first || t >= last; };
   if (!boxes_meet(box, all_)) return false;
   for (std::uint32_t t : large_)
-    if (t != own && boxes_meet(box, extents_[t])) return true;
+    if (outside(t) && boxes_meet(box, extents_[t])) return true;
   std::int64_t x0, y0, x1, y1;
   cell_range(box, x0, y0, x1, y1);
   for (std::int64_t y = y0; y <= y1; ++y)
     for (std::int64_t x = x0; x <= x1; ++x)
       for (std::uint32_t t : cells_[static_cast<std::size_t>(y * nx_ + x)])
-        if (t != own && boxes_meet(box, extents_[t])) return true;
+        if (outside(t) && boxes_meet(box, extents_[t])) return true;
   return false;
 }
 

@@ -22,7 +22,11 @@ class TileExtents {
   /// `extents[t]`: tile t's extent (empty for a tile without footprints).
   explicit TileExtents(std::vector<Box> extents);
   /// True when `box` meets the extent of a tile other than `own`.
-  bool meets_other(const Box& box, std::uint32_t own) const;
+  bool meets_other(const Box& box, std::uint32_t own) const { return meets_outside(box, own, own + 1); }
+  /// True when `box` meets the extent of a tile outside [first, last): the tiles a group of ranks has mapped
+  /// (the reduce tree's question).
+  bool meets_outside(const Box& box, std::uint32_t first, std::uint32_t last) const;
+  std::size_t size() const { return extents_.size(); }
 
  private:
   std::vector<Box> extents_;

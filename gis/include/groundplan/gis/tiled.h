@@ -22,6 +22,42 @@ struct StoredPlan {
   double min_z = 0, max_z = 0;          // over the members
 };
 
+/// How the ranks of a tiled run talk (issue 15 stage 2). One process is one rank (LocalExchange, never
+/// sending); `mpirun -np N groundplan` gives N (driver/cli/mpi_exchange.h). Every call but send/receive is
+/// collective: every rank makes it, in the same order. Any failure throws (an MPI build aborts the job).
+class TileExchange {
+ public:
+  virtual ~TileExchange() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  /// Every rank's `mine`, concatenated in rank order, on every rank; `sizes` (optional) gets each part's size.
+  virtual std::vector<char> allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes = nullptr) = 0;
+  /// Point to point, blocking; messages from one rank to another arrive in the order sent.
+  virtual void send(int to, const std::vector<char>& bytes) = 0;
+  virtual std::vector<char> receive(int from) = 0;
+};
+
+/// The exchange of a run in one process: rank 0 of 1.
+class LocalExchange final : public TileExchange {
+ public:
+  int rank() const override { return 0; }
+  int size() const override { return 1; }
+  std::vector<char> allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes = nullptr) override;
+  void send(int to, const std::vector<char>& bytes) override;
+  std::vector<char> receive(int from) override;
+};
+
+/// One rank's share of a run over ranks (--stats "mpi").
+struct RankStats {
+  std::size_t tiles = 0;            // input files it mapped
+  std::uint64_t bytes = 0;          // their bytes
+  std::size_t footprints = 0;       // footprints it made
+  std::size_t seam_footprints = 0;  // footprints it united in the reduce (its own and those received)
+  double map_s = 0, reduce_s = 0, gather_s = 0;  // wall: map; tree reduce; finals streamed to rank 0
+  double cpu_s = 0;
+  std::uint64_t peak_rss_bytes = 0;  // at the end of its part (rank 0: before writing)
+};
+
 /// What the tiled run did (--stats "tiles").
 struct TileStats {
   std::size_t tiles = 0;                // input files mapped one at a time (a tile each)
@@ -34,6 +70,7 @@ struct TileStats {
   std::size_t tiles_in_flight = 0;      // tiles read side by side at most (their footprints are in memory)
   std::uint64_t spill_bytes = 0;        // the map's temporary file (plans + their member footprints)
   double map_s = 0, reduce_s = 0;       // wall times: read + tile unions + spill; seams' union
+  std::size_t reduce_rounds = 0;        // the reduce tree's rounds after each rank's own: ceil(log2(ranks))
 };
 
 /// The result of a tiled run. The plans live in a temporary file (deleted when this is destroyed) and
@@ -58,6 +95,7 @@ class TiledResult {
   StageTimings timings;
   ReadStats reading;
   TileStats tiles;
+  std::vector<RankStats> ranks;     // rank 0 of a run over ranks: every rank's share, in rank order
   double extent[4] = {0, 0, 0, 0};  // xmin, ymin, xmax, ymax of all footprints (working CRS)
 };
 
@@ -73,5 +111,13 @@ std::uint64_t estimated_footprint_bytes(const std::vector<std::string>& inputs, 
 /// run_pipeline (as sets; the order is the one TiledResult states). A level of detail is refused
 /// (InvalidArgument): closing gaps and simplifying look past a plan's own box. Throws as run_pipeline.
 std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, const Progress& progress = {});
+
+/// The same run spread over the ranks of `exchange` (issue 15 stage 2): rank r maps a contiguous run of the
+/// input files (balanced by bytes), the tiles' extents are exchanged, each rank classifies its plans as the
+/// one-process tiled run does, the seams are reduced by a tree (rank pairs, ceil(log2 N) rounds) with the same
+/// engine, and every final plan is streamed to rank 0. Rank 0's result holds all plans, problems and counts;
+/// the other ranks' results hold none (plan_count() 0). Collective: every rank calls it.
+std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, TileExchange& exchange,
+                                                const Progress& progress = {});
 
 }  // namespace groundplan::gis

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: MIT
+#include "mpi_exchange.h"
+
+#include <groundplan/error.h>
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+
+#include <unistd.h>
+
+namespace groundplan::cli {
+namespace {
+
+constexpr int kTag = 15;
+constexpr std::uint64_t kChunk = std::uint64_t{1} << 30;  // MPI counts are int: large messages go in pieces
+
+void check(int rc, const char* what) {
+  if (rc == MPI_SUCCESS) return;
+  char text[MPI_MAX_ERROR_STRING];
+  int n = 0;
+  MPI_Error_string(rc, text, &n);
+  throw Error(std::string("MPI ") + what + " failed: " + std::string(text, static_cast<std::size_t>(n)));
+}
+
+}  // namespace
+
+bool launched_by_mpirun() {
+  return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMIX_RANK") != nullptr;
+}
+
+std::string mpi_version() {
+  char text[MPI_MAX_LIBRARY_VERSION_STRING];
+  int n = 0;
+  MPI_Get_library_version(text, &n);
+  std::string s(text, static_cast<std::size_t>(n));
+  return s.substr(0, s.find_first_of(",\n"));
+}
+
+MpiExchange::MpiExchange(int* argc, char*** argv) {
+  check(MPI_Init(argc, argv), "MPI_Init");
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+  check(MPI_Comm_rank(MPI_COMM_WORLD, &rank_), "MPI_Comm_rank");
+  check(MPI_Comm_size(MPI_COMM_WORLD, &size_), "MPI_Comm_size");
+}
+
+MpiExchange::~MpiExchange() { MPI_Finalize(); }
+
+void MpiExchange::barrier() {
+  test_failure(true);
+  check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
+}
+
+void MpiExchange::abort(const std::string& why, int code) {
+  std::fprintf(stderr, "groundplan: rank %d of %d: %s; aborting every rank of the run (nothing is written)\n", rank_,
+               size_, why.c_str());
+  std::fflush(stderr);
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::_Exit(code);
+}
+
+// A test hook (tests/e2e/test_mpi.py): GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW makes rank RANK fail at its second
+// allgather (after the map), or with HOW ending in "@end" at the final barrier (rank 0 has written then):
+// HOW = throw (an exception, as a failing rank) or kill (SIGKILL, as a dead one).
+void MpiExchange::test_failure(bool at_end) {
+  if (!at_end && ++calls_ != 2) return;
+  const char* v = std::getenv("GROUNDPLAN_MPI_TEST_FAIL");
+  if (!v) return;
+  std::string s(v);
+  const bool end = s.size() > 4 && s.compare(s.size() - 4, 4, "@end") == 0;
+  if (end != at_end) return;
+  if (end) s.resize(s.size() - 4);
+  const std::size_t colon = s.find(':');
+  if (colon == std::string::npos || std::atoi(s.substr(0, colon).c_str()) != rank_) return;
+  if (s.substr(colon + 1) == "kill") ::raise(SIGKILL);
+  throw Error("GROUNDPLAN_MPI_TEST_FAIL: rank " + std::to_string(rank_) + " fails on purpose");
+}
+
+std::vector<char> MpiExchange::allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes) {
+  test_failure(false);
+  if (mine.size() > static_cast<std::size_t>(1) << 30) throw Error("MPI allgather: a part over 1 GiB");
+  int n = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(size_));
+  check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
+  std::vector<int> displs(counts.size(), 0);
+  std::int64_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (total > INT32_MAX - counts[r]) throw Error("MPI allgather: over 2 GiB in all");
+    displs[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  std::vector<char> all(static_cast<std::size_t>(total));
+  check(MPI_Allgatherv(mine.data(), n, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, MPI_COMM_WORLD),
+        "MPI_Allgatherv");
+  if (sizes) sizes->assign(counts.begin(), counts.end());
+  return all;
+}
+
+void MpiExchange::send(int to, const std::vector<char>& bytes) {
+  const std::uint64_t n = bytes.size();
+  check(MPI_Send(&n, 1, MPI_UINT64_T, to, kTag, MPI_COMM_WORLD), "MPI_Send");
+  for (std::uint64_t at = 0; at < n; at += kChunk) {
+    const int part = static_cast<int>(std::min(kChunk, n - at));
+    check(MPI_Send(bytes.data() + at, part, MPI_BYTE, to, kTag, MPI_COMM_WORLD), "MPI_Send");
+  }
+}
+
+std::vector<char> MpiExchange::receive(int from) {
+  std::uint64_t n = 0;
+  check(MPI_Recv(&n, 1, MPI_UINT64_T, from, kTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
+  std::vector<char> bytes(static_cast<std::size_t>(n));
+  for (std::uint64_t at = 0; at < n; at += kChunk) {
+    const int part = static_cast<int>(std::min(kChunk, n - at));
+    check(MPI_Recv(bytes.data() + at, part, MPI_BYTE, from, kTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
+  }
+  return bytes;
+}
+
+}  // namespace groundplan::cli

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// `mpirun -np N groundplan ...` (issue 15 stage 2): the ranks of the tiled run talk through MPI. Built only with
+// GROUNDPLAN_MPI (CMake); without mpirun (no Open MPI launcher in the environment) MPI is never initialised and
+// the CLI is the one-process CLI.
+#include <groundplan/gis/tiled.h>
+
+#include <memory>
+#include <string>
+
+namespace groundplan::cli {
+
+class MpiExchange final : public gis::TileExchange {
+ public:
+  /// MPI_Init; throws Error when MPI cannot start.
+  MpiExchange(int* argc, char*** argv);
+  /// MPI_Finalize (after a barrier: a rank that died makes mpirun end the others first).
+  ~MpiExchange() override;
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+  std::vector<char> allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes = nullptr) override;
+  void send(int to, const std::vector<char>& bytes) override;
+  std::vector<char> receive(int from) override;
+  /// Waits for every rank (collective).
+  void barrier();
+  /// Ends every rank of the job at once (MPI_Abort), after saying why on stderr. Does not return.
+  [[noreturn]] void abort(const std::string& why, int code = 1);
+
+ private:
+  int rank_ = 0, size_ = 1;
+  int calls_ = 0;  // for GROUNDPLAN_MPI_TEST_FAIL
+  void test_failure(bool at_end);
+};
+
+/// True when this process was started by Open MPI's mpirun (its environment says so).
+bool launched_by_mpirun();
+
+/// The MPI library's version line (for --version).
+std::string mpi_version();
+
+}  // namespace groundplan::cli

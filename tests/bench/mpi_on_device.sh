@@ -1,0 +1,79 @@
+#!/bin/bash
+# SPDX-License-Identifier: MIT
+# Issue 15 stage 2 on the 16-core host (no GDAL, no MPI there): `mpirun -np N groundplan` for N = 1, 2, 4, 8, 16 on a
+# generated tiled city (gen_tiled_city.py; default 8 x 8 tiles of 8 x 8 copies of the Lorup tile, about 3.3 GB),
+# one thread a rank. Prints a line a run: wall, the reduce step's share (the slowest rank's reduce + gather over the
+# wall), speed-up and efficiency against N = 1, peak RSS of the largest rank; then per rank: tiles, bytes, map,
+# reduce, gather, peak RSS; and whether every N gave the plans of N = 1 (sorted lines of ground_plans as CSV).
+# The bundle: the CLI packed with Open MPI (mpirun = orterun, orted, plugins), from the repository root:
+#   PACK_MPI=1 tests/gpu/pack_cli.sh build /tmp/gp-mpi.tar.xz
+#   tests/bench/mpi_on_device.sh /tmp/gp-mpi.tar.xz [TX TY K] [RANKS...]
+# Open MPI is relocated with OPAL_PREFIX (its Debian layout is kept under gp/ompi; checked on the 2-core VM with
+# Debian's own Open MPI folders hidden by tmpfs mounts in `unshare -m`: 3 ranks ran from the bundle alone); if
+# mpirun cannot start there, the script says so and stops.
+set -u
+BUNDLE=${1:?BUNDLE}; TX=${2:-8}; TY=${3:-8}; K=${4:-8}; shift $(( $# < 4 ? $# : 4 ))
+RANKS=${*:-1 2 4 8 16}
+OUT=${OUT:-mpi-out}; mkdir -p "$OUT"
+exec > >(tee "$OUT/mpi.log") 2>&1
+W=/tmp/gp-mpi; rm -rf "$W"; mkdir -p "$W"
+xz -dc "$BUNDLE" | tar -C "$W" -xf - || { echo "cannot unpack $BUNDLE"; exit 1; }
+G=$W/gp; O=$G/ompi
+export OPAL_PREFIX=$O PATH=$O/bin:$PATH
+export LD_LIBRARY_PATH=$O/lib/x86_64-linux-gnu/openmpi/lib:$G/lib GDAL_DATA=$G/share/gdal PROJ_DATA=$G/share/proj
+export PMIX_INSTALL_PREFIX=$O PMIX_MCA_mca_base_component_path=$O/lib/x86_64-linux-gnu/pmix2/lib/pmix
+export OMPI_MCA_btl=self,vader OMPI_MCA_plm=isolated 2>/dev/null  # one host: shared memory only
+MPIRUN=(mpirun --allow-run-as-root --oversubscribe --bind-to none -x LD_LIBRARY_PATH -x GDAL_DATA -x PROJ_DATA)
+echo "== machine"; date -u; nproc; lscpu | grep -E "Model name|^Core|^Socket"; free -g | head -2
+$G/bin/groundplan --version || { ldd $G/bin/groundplan | grep "not found"; exit 1; }
+if ! "${MPIRUN[@]}" -np 2 $G/bin/groundplan --version; then
+  unset OMPI_MCA_plm
+  "${MPIRUN[@]}" -np 2 $G/bin/groundplan --version ||
+    { echo "mpirun does not start from the bundle (OPAL_PREFIX=$O): not workable here"; exit 1; }
+fi
+
+echo "== city: gen_tiled_city.py $TX x $TY tiles, $K x $K copies each"
+s=$(date +%s); python3 tests/bench/gen_tiled_city.py "$W/city" "$TX" "$TY" "$K" | tail -1
+echo "  $(ls "$W/city" | wc -l) files, $(du -sb "$W/city" | cut -f1) bytes, made in $(( $(date +%s) - s )) s"
+cat "$W"/city/* > /dev/null  # in the page cache for every run
+
+for n in $RANKS; do
+  rm -rf "$W/out_$n"
+  s=$(date +%s.%N)
+  /usr/bin/time -f %M -o "$W/rss_$n" "${MPIRUN[@]}" -np "$n" $G/bin/groundplan -q --device cpu --threads 1 --tiles on --stats "$W/s_$n.json" \
+    -f CSV -lco GEOMETRY=AS_WKT "$W/out_$n" "$W/city" ground_plans || { echo "np $n: failed"; continue; }
+  python3 -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$s" "$(date +%s.%N)" > "$W/wall_$n"
+done
+
+python3 - "$W" $RANKS <<'PY'
+import csv, json, sys
+csv.field_size_limit(1 << 30)
+w, ranks = sys.argv[1], sys.argv[2:]
+def plans(n):
+    with open(f"{w}/out_{n}/ground_plans.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    def cyc(t):
+        p = t.strip().split(",")[:-1]
+        k = min(range(len(p)), key=lambda i: tuple(map(float, p[i].split())))
+        return tuple(p[k:] + p[:k])
+    return sorted((tuple(cyc(r) for r in x["WKT"][10:-2].split("),(")), x["building_ids"]) for x in rows)
+base_wall = base = None
+for n in ranks:
+    try:
+        s = json.load(open(f"{w}/s_{n}.json")); wall = float(open(f"{w}/wall_{n}").read())
+    except OSError:
+        print(f"np {n}: no result"); continue
+    per = s.get("mpi", {}).get("per_rank") or [{"tiles": s["tiles"]["tiles"], "bytes": s["reading"]["bytes"],
+        "map_s": s["tiles"]["map_s"], "reduce_s": s["tiles"]["reduce_s"], "gather_s": 0,
+        "peak_rss_bytes": int(open(f"{w}/rss_{n}").read().split()[-1]) * 1024}]  # np 1: no "mpi" section
+    reduce = max(r["reduce_s"] + r["gather_s"] for r in per)
+    base_wall = base_wall or wall
+    p = plans(n); base = base or p
+    print(f"np {n:>2}: wall {wall:7.2f} s, reduce+gather {reduce:6.2f} s ({100 * reduce / wall:4.1f} %), speed-up "
+          f"{base_wall / wall:5.2f}, efficiency {100 * base_wall / wall / int(n):5.1f} %, peak RSS max "
+          f"{max(r['peak_rss_bytes'] for r in per) / 2**20:6.0f} MiB, plans {len(p)}, same as np {ranks[0]}: {p == base}")
+    for i, r in enumerate(per):
+        print(f"    rank {i:>2}: tiles {r['tiles']:>3} bytes {r['bytes'] / 2**20:8.1f} MiB map {r['map_s']:7.2f} s "
+              f"reduce {r['reduce_s']:6.2f} s gather {r['gather_s']:6.2f} s peak RSS {r['peak_rss_bytes'] / 2**20:6.0f} MiB")
+    print("    tiles:", json.dumps(s["tiles"]))
+PY

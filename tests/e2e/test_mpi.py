@@ -1,0 +1,172 @@
+# SPDX-License-Identifier: MIT
+"""Issue 15 stage 2: `mpirun -np N groundplan ...` spreads the tiled run over N ranks (a contiguous run of tiles
+each, balanced by bytes; seams reduced by a tree of rank pairs; rank 0 writes the one dataset). The plans, members
+and problems must be those of the one-process run (as test_tiles.py compares them: exact ring cycles), for every
+N; no plan split at a tile edge (no two plans share more than corner points), every plan GEOS-valid, nothing lost (buildings = member rows
++ dropped). A bad tile is a problem and the run completes; a rank that dies ends the run with a message and no
+dataset. Skipped when the build has no MPI or mpirun is missing."""
+import json
+import math
+import os
+import shutil
+import subprocess
+
+import pytest
+from osgeo import ogr
+
+from conftest import BIN, SHARED_DATA, gdal_env, run
+from test_tiles import COURTYARDS, ROW, generated_city, outputs
+
+NIEDERSACHSEN = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
+
+
+def mpi_build():
+    if shutil.which("mpirun") is None:
+        return False
+    p = subprocess.run([BIN, "--version"], capture_output=True, text=True, env=gdal_env())
+    return "MPI:" in p.stdout
+
+
+pytestmark = pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
+
+
+def mpirun(n):
+    # As root in CI and containers; more ranks than cores on a small machine.
+    return ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(n)]
+
+
+def check_plans(result, stats, ranks, tiles):
+    """Every plan GEOS-valid, no two plans share an edge (none split at a tile edge), nothing lost, the run's
+    shape."""
+    plans = [ogr.CreateGeometryFromWkt("POLYGON (" + ",".join(
+        "(" + ",".join(ring) + "," + ring[0] + ")" for ring in (p[0][0], *p[0][1])) + ")") for p in result[0]]
+    assert all(g.IsValid() for g in plans)
+    boxes = [g.GetEnvelope() for g in plans]  # minx, maxx, miny, maxy
+    order = sorted(range(len(plans)), key=lambda i: boxes[i][0])
+    for a, i in enumerate(order):
+        for j in order[a + 1:]:
+            if boxes[j][0] > boxes[i][1]:
+                break
+            # Buildings touching at a corner only stay apart (one plan would not be a valid polygon); a plan split
+            # at a tile edge would share a line with its other part.
+            if plans[i].Intersects(plans[j]):
+                assert plans[i].Intersection(plans[j]).GetDimension() <= 0, "two plans share an edge: one was split"
+    c = stats["counts"]
+    assert c["buildings"] == c["footprints"] + c["dropped"]
+    assert len(result[1]) == c["footprints"]  # every footprint is a member of one plan
+    assert sorted({m[1] for m in result[1]}) == list(range(1, c["footprints"] + 1))
+    if ranks > 1:
+        m = stats["mpi"]
+        assert m["ranks"] == ranks
+        assert m["reduce_rounds"] == math.ceil(math.log2(ranks))
+        assert sum(r["tiles"] for r in m["per_rank"]) == tiles
+        assert sum(r["footprints"] for r in m["per_rank"]) == c["footprints"]
+        if tiles >= ranks:
+            assert all(r["tiles"] >= 1 for r in m["per_rank"])
+    else:
+        assert "mpi" not in stats
+
+
+@pytest.fixture(scope="module")
+def city(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("mpi") / "city"
+    tiles = generated_city(folder)
+    return folder, tiles
+
+
+@pytest.fixture(scope="module")
+def city_one(city, tmp_path_factory):
+    return outputs(tmp_path_factory.mktemp("one"), "one", city[0], "--tiles", "off", "--id-field", "bid")
+
+
+@pytest.mark.parametrize("ranks", [1, 2, 3, 4])
+def test_generated_city_over_ranks(tmp_path, city, city_one, ranks):
+    folder, tiles = city
+    got = outputs(tmp_path, "mpi", folder, "--tiles", "on", "--id-field", "bid", launcher=mpirun(ranks))
+    assert len(got[0]) == COURTYARDS + 1
+    assert got[0] == city_one[0], "plans differ from the one-process run"
+    assert got[1] == city_one[1], "plan members differ"
+    assert got[2] == city_one[2], "problems differ"
+    assert sum(1 for p in got[0] if len(p[0][1]) == 1) == COURTYARDS
+    assert max(int(p[1]) for p in got[0]) == ROW
+    check_plans(got, got[3], ranks, tiles)
+    t = got[3]["tiles"]
+    assert t["tiles"] == tiles == 9
+    assert t["final_at_once"] + t["seam_plans"] == t["tile_plans"]
+    assert t["final_at_once"] + t["plans_from_seams"] == len(got[0])
+    assert t["seam_plans"] > 0
+
+
+def test_mpirun_without_tiles_on_takes_the_tiled_run(tmp_path, city, city_one):
+    """Under mpirun with several ranks --tiles auto means the ranks share the tiled run."""
+    folder, tiles = city
+    got = outputs(tmp_path, "auto", folder, "--id-field", "bid", launcher=mpirun(2))
+    assert got[0] == city_one[0]
+    assert got[3]["mpi"]["ranks"] == 2
+
+
+def test_real_niedersachsen_tiles_over_4_ranks(tmp_path):
+    one = outputs(tmp_path, "one", NIEDERSACHSEN, "--tiles", "off")
+    got = outputs(tmp_path, "mpi", NIEDERSACHSEN, "--tiles", "on", launcher=mpirun(4))
+    assert len(one[0]) > 100
+    assert got[0] == one[0], "plans differ from the one-process run"
+    assert got[1] == one[1], "plan members differ"
+    assert got[2] == one[2], "problems differ"
+    check_plans(got, got[3], 4, 4)
+
+
+def test_a_bad_tile_is_a_problem_and_the_run_completes(tmp_path):
+    folder = tmp_path / "tiles"
+    folder.mkdir()
+    for tile in sorted(NIEDERSACHSEN.glob("*.gml")):
+        (folder / tile.name).symlink_to(tile)
+    # last by name: the last rank's only tile, so its problem has to travel to rank 0
+    bad = '<?xml version="1.0"?>\n<CityModel><cityObjectMember><bldg'
+    (folder / "LoD1_99999999_broken.gml").write_text(bad)
+    one = outputs(tmp_path, "one", folder, "--tiles", "off")
+    got = outputs(tmp_path, "mpi", folder, "--tiles", "on", launcher=mpirun(3))
+    assert got[3]["mpi"]["per_rank"][2]["bytes"] == len(bad)
+    assert got[0] == one[0] and got[1] == one[1] and got[2] == one[2]
+    assert [p for p in got[2] if p[2] == "UNREADABLE_FILE"], got[2]
+    check_plans(got, got[3], 3, 5)
+
+
+@pytest.mark.parametrize("how", ["throw", "kill", "throw@end", "kill@end"])
+def test_a_rank_that_dies_aborts_the_run_and_writes_nothing(tmp_path, city, how):
+    """Rank 2 fails after the map, or rank 0 at the final barrier, when it has written (@end): non-zero exit, a
+    message, and no dataset under the name asked for (rank 0 writes into a hidden staging folder moved into place
+    after the barrier: removed when it throws, left when it is killed, never out.gpkg)."""
+    folder, _ = city
+    out = tmp_path / "out.gpkg"
+    env = gdal_env()
+    rank = 0 if how.endswith("@end") else 2
+    env["GROUNDPLAN_MPI_TEST_FAIL"] = f"{rank}:{how}"
+    p = subprocess.run([*mpirun(4), "-x", "GROUNDPLAN_MPI_TEST_FAIL", BIN, "-q", "--tiles", "on", "--id-field", "bid",
+                        "-f", "GPKG", str(out), str(folder)], capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode != 0
+    if how.startswith("throw"):
+        assert f"rank {rank} of 4: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr and "aborting every rank" in p.stderr, p.stderr
+    else:
+        assert f"rank {rank}" in p.stderr and "signal 9" in p.stderr, p.stderr
+    assert not out.exists()
+    left = os.listdir(tmp_path)
+    if how == "kill@end":  # killed with the dataset written in the staging folder: that folder is all there is
+        assert len(left) == 1 and left[0].startswith(".groundplan-partial-"), left
+        assert os.listdir(tmp_path / left[0]) == ["out.gpkg"]
+    else:
+        assert left == []
+
+
+def test_what_the_tiled_run_cannot_do_is_refused_over_ranks(tmp_path, city):
+    folder, _ = city
+    p = run([*mpirun(2), BIN, "--tiles", "off", "-f", "CSV", tmp_path / "x", folder], check=False)
+    assert p.returncode != 0 and "--tiles off" in p.stderr and "without mpirun" in p.stderr, p.stderr
+    assert not (tmp_path / "x").exists()
+
+
+def test_one_rank_without_mpirun_is_the_plain_cli(tmp_path, city, city_one):
+    """An MPI build started without mpirun never starts MPI: the same output as before, no "mpi" stats."""
+    folder, _ = city
+    got = outputs(tmp_path, "plain", folder, "--tiles", "on", "--id-field", "bid")
+    assert got[0] == city_one[0]
+    assert "mpi" not in got[3]
