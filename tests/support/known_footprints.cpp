@@ -158,6 +158,16 @@ Model stacked_overhang() {
   return m;
 }
 
+/// As stacked_boxes, the upper box (6 x 6) set on the lower one's north-east corner and reaching 3 m
+/// beyond it both ways: no wall top of the lower box lies under its middle, only its own bottom edges
+/// lie partly on the lower box's roof.
+Model stacked_corner() {
+  Model m{{}, kHouse, 80, 80 + 36 - 9};
+  box(m, 0, 0, 0, 10, 8, 3);
+  box(m, 7, 5, 3, 13, 11, 6);
+  return m;
+}
+
 /// Two houses 5 m apart in one model.
 Model disconnected() {
   Model m{{}, "MULTIPOLYGON(((0 0,10 0,10 8,0 8,0 0)),((15 0,21 0,21 5,15 5,15 0)))", 110, 110};
@@ -171,7 +181,7 @@ struct Family {
   Model (*make)();
 };
 
-constexpr std::array<Family, 9> kFamilies{{{"eaves_open", eaves_open},
+constexpr std::array<Family, 10> kFamilies{{{"eaves_open", eaves_open},
                                           {"eaves_soffit", eaves_soffit},
                                           {"slab_roof", slab_roof},
                                           {"cantilever", cantilever},
@@ -179,6 +189,7 @@ constexpr std::array<Family, 9> kFamilies{{{"eaves_open", eaves_open},
                                           {"stepped_ground", stepped_ground},
                                           {"stacked_boxes", stacked_boxes},
                                           {"stacked_overhang", stacked_overhang},
+                                          {"stacked_corner", stacked_corner},
                                           {"disconnected", disconnected}}};
 
 /// Convex faces fanned into triangles (corners shared bit for bit, orientation kept).

@@ -28,7 +28,7 @@ struct KnownFootprint {
 };
 
 /// The families, in order: eaves_open, eaves_soffit, slab_roof, cantilever, balcony, stepped_ground,
-/// stacked_boxes, stacked_overhang, disconnected.
+/// stacked_boxes, stacked_overhang, stacked_corner, disconnected.
 std::vector<std::string> known_footprint_families();
 
 /// Every family x writing x floor, deterministic (fixed seeds).

@@ -34,6 +34,7 @@ DecomposeResult Decomposer::run(SurfaceDecomposition* dec) {
   orient();
   classify();
   find_hanging_floors();
+  find_contacts();
   if (dec) fill_decomposition(*dec);
   collect_footprint_edges();
   chain_loops();
@@ -41,6 +42,8 @@ DecomposeResult Decomposer::run(SurfaceDecomposition* dec) {
   if (p_.shadow_fallback && (res.polygons.empty() || open_outside_loops())) {
     res.polygons.clear();
     make_shadow(res.polygons);
+  } else {
+    unite_loops(res.polygons);
   }
   return res;
 }

@@ -47,32 +47,13 @@ double summed_area(const std::vector<Polygon>& polys) {
 /// Cases that fail today, each named; they run as DISABLED_ tests below until issue 21 fixes them.
 const std::set<std::string>& failing_today() {
   // Measured at the split (before any fix): slab_roof, balcony, stacked_boxes and stacked_overhang in
-  // every writing, stepped_ground with its floor (the upper floor hangs from the riser).
+  // every writing failed too (slab_roof and stacked_* fixed by contacts.cpp). Still open: balcony
+  // (the slab's underside is a closed loop of its own; contacts.cpp says why a floor edge lying in a
+  // wall does not make it hang), and stepped_ground with its floor (the upper floor hangs from the
+  // riser that goes down from its edge, so the upper half has no loop).
   static const std::set<std::string> names = {
-      "balcony_polygons_floor",
-      "balcony_polygons_open",
-      "balcony_soup_floor",
-      "balcony_soup_open",
-      "balcony_triangles_floor",
-      "balcony_triangles_open",
-      "slab_roof_polygons_floor",
-      "slab_roof_polygons_open",
-      "slab_roof_soup_floor",
-      "slab_roof_soup_open",
-      "slab_roof_triangles_floor",
-      "slab_roof_triangles_open",
-      "stacked_boxes_polygons_floor",
-      "stacked_boxes_polygons_open",
-      "stacked_boxes_soup_floor",
-      "stacked_boxes_soup_open",
-      "stacked_boxes_triangles_floor",
-      "stacked_boxes_triangles_open",
-      "stacked_overhang_polygons_floor",
-      "stacked_overhang_polygons_open",
-      "stacked_overhang_soup_floor",
-      "stacked_overhang_soup_open",
-      "stacked_overhang_triangles_floor",
-      "stacked_overhang_triangles_open",
+      "balcony_polygons_floor", "balcony_polygons_open", "balcony_soup_floor",
+      "balcony_soup_open", "balcony_triangles_floor", "balcony_triangles_open",
       "stepped_ground_polygons_floor",
       "stepped_ground_soup_floor",
       "stepped_ground_triangles_floor",

@@ -183,6 +183,9 @@ struct Workspace {
   std::vector<std::int32_t> poly_of_loop;
   std::vector<std::uint32_t> floor_uf;
   std::vector<std::uint8_t> hanging;
+  std::vector<std::uint32_t> face_pts_start;  // contacts.cpp: each face's outer ring, projected along its normal
+  std::vector<Point2> face_pts;
+  std::vector<std::uint8_t> on_roof;  // per edge group: its walls stand on another part's ceiling (contacts.cpp)
 };
 
 /// Half-edge h, of the undirected edge lo < hi, into its group (groups numbered in order of first
@@ -248,6 +251,10 @@ inline bool inside(const Point2* ring, std::size_t n, Point2 p) {
   }
   return in;
 }
+
+/// `polys` replaced by their union (the project's exact engine), rings under min_ring_m2 dropped;
+/// false (and `polys` unchanged) when the engine fails. unite.cpp.
+bool unite_polygons(std::vector<Polygon>& polys, double min_ring_m2);
 
 class Decomposer {
  public:
@@ -425,6 +432,19 @@ class Decomposer {
   /// storey wider than the one below), not ground: walls rising from them are no footprint, or a
   /// storey overhanging on every side would give its shadow. hanging[f] for floor facets.
   void find_hanging_floors();
+
+  // ---- 4b. contacts: parts that touch without sharing edges (contacts.cpp) -----------------------
+  /// Floors hang, and wall bottoms stand on roofs, where an edge of one part lies in a face of
+  /// another (issue 21): ws_.hanging, ws_.on_roof.
+  void find_contacts();
+  /// Each used face's outer ring projected along its normal's largest component (face_pts).
+  void project_faces();
+  /// Whether the edge p q lies in face f within the weld tolerance (ends on its plane, midpoint on it).
+  bool edge_on_face(std::uint32_t f, const V3& p, const V3& q) const;
+
+  // ---- 7b. one footprint never overlaps itself (unite.cpp) ---------------------------------------
+  /// Polygons whose boxes meet are united with the project's union engine (issue 21).
+  void unite_loops(std::vector<Polygon>& polys);
 
   void fill_decomposition(SurfaceDecomposition& dec);
 

@@ -28,6 +28,7 @@ void Decomposer::collect_footprint_edges() {
   const FaceInfo* F = ws_.faces.data();
   const std::uint8_t* hanging = ws_.hanging.data();
   for (std::size_t g = 0; g < ng; ++g) {
+    if (ws_.on_roof[g]) continue;  // stands on another part's roof (contacts.cpp)
     const std::uint32_t s = st[g], c = cnt[g];
     int net = 0;
     bool below = false;

@@ -9,8 +9,6 @@
 #include "footprint/decompose.h"
 #include "footprint/decompose/decomposer.h"
 
-#include <groundplan/ground_plans.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -29,7 +27,6 @@ constexpr double kShadowMinRing_m2 = 0.01;
 /// go out as they are (overlapping polygons, which the pipeline's union merges anyway).
 void Decomposer::make_shadow(std::vector<Polygon>& out) {
   Footprint fp;
-  double minx = std::numeric_limits<double>::infinity(), maxx = -minx, miny = minx, maxy = -minx;
   for (std::uint32_t f = 0; f < ws_.faces.size(); ++f) {
     // Walls too: one leaning by a hair bridges a modelling gap of millimetres (an annex drawn a
     // hair off the hall); the slivers they leave elsewhere are dropped below.
@@ -54,8 +51,6 @@ void Decomposer::make_shadow(std::vector<Polygon>& out) {
       const bool outer = r == mf.first_ring;
       if ((a > 0) != outer) std::reverse(ring.begin(), ring.end());
       if (outer) {
-        for (const Point2& q : ring)
-          minx = std::min(minx, q.x), maxx = std::max(maxx, q.x), miny = std::min(miny, q.y), maxy = std::max(maxy, q.y);
         poly.outer = std::move(ring);
       } else {
         poly.holes.push_back(std::move(ring));
@@ -65,28 +60,10 @@ void Decomposer::make_shadow(std::vector<Polygon>& out) {
   }
   if (fp.polygons.empty()) return;
   stats_->shadow = true;
-  UnionParams up;
-  up.threads = 1;  // decomposition runs on the caller's thread (the pipeline parallelises buildings)
-  up.device = Device::Cpu;
-  up.resolution_m = std::max({maxx - minx, maxy - miny, 1e-6}) / 256;  // blocks only; exactness does not depend on it
-  std::vector<Problem> problems;
-  std::vector<GroundPlan> plans;
-  try {
-    plans = build_ground_plans(std::vector<Footprint>{fp}, up, problems);
-  } catch (const std::exception&) {
-    plans.clear();
-  }
-  if (plans.empty()) {
-    out = std::move(fp.polygons);
-    return;
-  }
-  // Rings under kShadowMinRing_m2 are what walls leaning by a hair leave along their lines.
-  for (GroundPlan& g : plans) {
-    if (std::fabs(ring_area(g.polygon.outer)) < kShadowMinRing_m2) continue;
-    auto& h = g.polygon.holes;
-    h.erase(std::remove_if(h.begin(), h.end(), [](const Ring& r) { return std::fabs(ring_area(r)) < kShadowMinRing_m2; }), h.end());
-    out.push_back(std::move(g.polygon));
-  }
+  // Rings under kShadowMinRing_m2 are what walls leaning by a hair leave along their lines. Should
+  // the union fail, the projected facets go out as they are (the pipeline's union merges them).
+  out = std::move(fp.polygons);
+  unite_polygons(out, kShadowMinRing_m2);
 }
 
 }  // namespace groundplan::footprint::detail
