@@ -76,6 +76,8 @@ struct DecomposeStats {
   std::size_t chained_in_plan = 0;        // chains closed only when joined in plan view (stepped bottoms)
   std::size_t contacts = 0;               // edges found lying in another part's face (parts laid on each other)
   bool united = false;                    // the loops overlapped and were united into one footprint
+  double lower_boundary_m = 0;           // plan length of the footprint edges (set when chains stay open)
+  double open_outside_m = 0;              // of which in open chains outside every loop, no higher than them
   bool shadow = false;                    // the polygons are the shadow (shadow_fallback), not loops
 };
 

@@ -6,6 +6,7 @@
 #include "footprint/decompose.h"
 #include "known_footprints.h"
 
+#include <groundplan/footprint.h>
 #include <groundplan/gis/geos_reference.h>
 #include <gtest/gtest.h>
 
@@ -123,6 +124,39 @@ TEST(KnownFootprintGenerator, ShadowAndTruthAgreeWithTheModel) {
     for (const GroundPlan& u : gis::geos_union({proj})) both += summed_area({u.polygon});
     EXPECT_NEAR(both, k.shadow_area_m2, 1e-6) << k.name << ": the true footprint reaches outside the model";
   }
+}
+
+/// The shadow only as the last resort, and then said why (issue 21): four walls with 5 cm gaps at the
+/// corners close no loop, so the footprint is the shadow and the note says the loops failed; a true
+/// model gets its loop and no note.
+TEST(FootprintShadowNote, SaysWhyTheLoopsFailed) {
+  Mesh gappy;
+  const double g = 0.05;
+  auto wall = [&](Point3 a, Point3 b) { gappy.add_face({{a, b, {b.x, b.y, 3}, {a.x, a.y, 3}}}, SurfaceKind::Unknown, 255); };
+  wall({g, 0, 0}, {10 - g, 0, 0});
+  wall({10, g, 0}, {10, 8 - g, 0});
+  wall({10 - g, 8, 0}, {g, 8, 0});
+  wall({0, 8 - g, 0}, {0, g, 0});
+  gappy.add_face({{{0, 0, 3}, {10, 0, 3}, {10, 8, 3}, {0, 8, 3}}}, SurfaceKind::Unknown, 255);
+  FootprintParams params;
+  params.source = FootprintSource::Decompose;
+  const FootprintResult shadow = make_footprint(gappy, params);
+  ASSERT_TRUE(shadow.ok);
+  EXPECT_EQ(shadow.method, FootprintMethod::DecompositionShadow);
+  EXPECT_NE(shadow.note.find("footprint is the shadow: the walls' lower boundary closed no loop"), std::string::npos)
+      << shadow.note;
+  params.source = FootprintSource::Auto;  // no ground faces either: the explicit route's failure comes first
+  const FootprintResult autom = make_footprint(gappy, params);
+  EXPECT_EQ(autom.method, FootprintMethod::DecompositionShadow);
+  EXPECT_EQ(autom.note.rfind("no GroundSurface", 0), 0u) << autom.note;
+  EXPECT_NE(autom.note.find("; footprint is the shadow"), std::string::npos) << autom.note;
+  for (const KnownFootprint& k : test::known_footprints())
+    if (k.name == "slab_roof_polygons_open") {
+      params.source = FootprintSource::Decompose;
+      const FootprintResult loop = make_footprint(k.mesh, params);
+      EXPECT_EQ(loop.method, FootprintMethod::Decomposition);
+      EXPECT_TRUE(loop.note.empty()) << loop.note;
+    }
 }
 
 std::string case_name(const ::testing::TestParamInfo<KnownFootprint>& info) { return info.param.name; }

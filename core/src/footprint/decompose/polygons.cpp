@@ -105,6 +105,8 @@ bool Decomposer::open_outside_loops() const {
     }
     if (!in) outside += plan_length(ws_.cand[e]);
   }
+  stats_->lower_boundary_m = lower_boundary_len_;
+  stats_->open_outside_m = outside;
   return outside >= 0.1 * lower_boundary_len_;
 }
 
