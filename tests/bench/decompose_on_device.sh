@@ -18,7 +18,7 @@ if [ -f /usr/include/mpfr.h ] && [ -d /usr/include/tbb ]; then
 else
   echo "== build without the union engine (no MPFR/TBB headers): decompose_replay_no_union.cpp stands in;"
   echo "   sets with 'shadow' above 0 are then not the same computation as on the project's build"
-  srcs="core/src/footprint/decompose.cpp tests/bench/decompose_replay_no_union.cpp"; libs=""
+  srcs="core/src/footprint/decompose.cpp $(ls core/src/footprint/decompose/*.cpp) tests/bench/decompose_replay_no_union.cpp"; libs=""
 fi
 objs=""; pids=""
 for s in $srcs tests/bench/decompose_replay.cpp; do

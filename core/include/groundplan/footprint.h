@@ -47,6 +47,7 @@ struct FootprintResult {
   std::string code;              // when !ok: "NO_GROUND_GEOMETRY" (auto, ground-surface), "NO_FOOTPRINT_LOOP"
                                  // (decompose), "EMPTY_MESH"
   std::string reason;            // when !ok: one sentence for the Problem
+  std::string note;              // when ok but found by a last resort (the shadow): why the earlier methods failed
 };
 
 /// The footprint of one building (part). Never throws for bad geometry: !ok with a reason instead.

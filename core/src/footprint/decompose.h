@@ -10,13 +10,16 @@
 // solid and are skipped. Coordinates: x, y metric (working CRS), z up, metres.
 //
 // Output: polygons in the mesh's x, y with outer rings counter-clockwise and holes clockwise, closed
-// (no repeated closing vertex), no NaN. Rings of different parts of one mesh may overlap (the union
-// engine merges them). Never throws for bad geometry: an empty result and the stats say why.
+// (no repeated closing vertex), no NaN. The polygons never overlap: loops of different parts that do
+// are united (the project's union engine, issue 21). Never throws for bad geometry: an empty result
+// and the stats say why.
 //
 // Rules beyond the paper, in order of use: (1) the lower boundary is chained over welded 3D vertices;
 // (2) chains that do not close are chained again in plan view (endpoints within weld_tolerance_m in
 // x, y are one), so a wall bottom stepping up or down a terraced site at a vertical edge still closes;
-// (3) where the loops miss the ground-level lower boundary, the shadow (DecomposeParams::shadow_fallback).
+// (3) where the loops miss the ground-level lower boundary, the shadow (DecomposeParams::shadow_fallback);
+// (4) parts that touch without sharing edges meet where an edge of one lies in a face of the other
+// (decompose/contacts.cpp: slabs laid on walls, boxes set on roofs, balconies against walls).
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
@@ -71,6 +74,10 @@ struct DecomposeStats {
   std::size_t holes = 0;                  // loops that became holes
   std::size_t dropped_loops = 0;          // loops below min area, or holes inside no outer ring
   std::size_t chained_in_plan = 0;        // chains closed only when joined in plan view (stepped bottoms)
+  std::size_t contacts = 0;               // edges found lying in another part's face (parts laid on each other)
+  bool united = false;                    // the loops overlapped and were united into one footprint
+  double lower_boundary_m = 0;           // plan length of the footprint edges (set when chains stay open)
+  double open_outside_m = 0;              // of which in open chains outside every loop, no higher than them
   bool shadow = false;                    // the polygons are the shadow (shadow_fallback), not loops
 };
 

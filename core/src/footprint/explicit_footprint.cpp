@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace groundplan {
@@ -101,6 +102,20 @@ bool decompose_into(const Mesh& mesh, const FootprintParams& params, FootprintRe
     res.footprint.polygons = std::move(d.polygons);
     res.ok = true;
     res.method = d.stats.shadow ? FootprintMethod::DecompositionShadow : FootprintMethod::Decomposition;
+    if (d.stats.shadow) {
+      // Issue 21: say why the wall loops were not taken (the shadow also covers every overhang).
+      char buf[400];
+      if (d.stats.loops == 0)
+        std::snprintf(buf, sizeof buf,
+                      "footprint is the shadow: the walls' lower boundary closed no loop (%zu lower-boundary edges, "
+                      "%zu chains that do not close)", d.stats.footprint_edges, d.stats.open_chains);
+      else
+        std::snprintf(buf, sizeof buf,
+                      "footprint is the shadow: %.1f m of the walls' lower boundary (%.1f m in all) lies in %zu chains "
+                      "that do not close, outside the %zu loops and no higher (a model that is not watertight)",
+                      d.stats.open_outside_m, d.stats.lower_boundary_m, d.stats.open_chains, d.stats.loops);
+      res.note = buf;
+    }
     return true;
   }
   why = "surface decomposition found no closed lower wall boundary (" + std::to_string(d.stats.faces_used) +
@@ -242,6 +257,7 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   if (params.source == FootprintSource::Auto) {
     std::string why;
     if (decompose_into(mesh, params, res, why)) {
+      if (!res.note.empty()) res.note = res.reason + "; " + res.note;  // the explicit route's failure first
       res.code.clear();
       res.reason.clear();
       return res;
