@@ -70,14 +70,16 @@ int point_in_ring(const Point2& p, const std::vector<Point2>& r) {
   return odd ? 1 : -1;
 }
 
-/// Validity of one plan on its rounded coordinates, exactly (robust predicates on the doubles):
-/// OGC says no two ring edges may cross or overlap, and a ring may not touch itself; rings of one
-/// plan may touch at points. Returns false and the ring/vertex of a conflict if invalid.
-bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) {
-  struct Seg {
-    double minx, maxx, miny, maxy;
-    std::size_t ring, edge;
-  };
+namespace {
+
+/// One ring edge's box, for the sweep over edges in order of their least x.
+struct Seg {
+  double minx, maxx, miny, maxy;
+  std::size_t ring, edge;
+};
+
+/// Every edge of every ring (ring r's edge i runs from vertex i to i + 1, cyclically), by least x.
+std::vector<Seg> edges_by_min_x(const std::vector<std::vector<Point2>*>& rings) {
   std::vector<Seg> segs;
   for (std::size_t r = 0; r < rings.size(); ++r) {
     const auto& R = *rings[r];
@@ -88,6 +90,16 @@ bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) 
     }
   }
   std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.minx < y.minx; });
+  return segs;
+}
+
+}  // namespace
+
+/// Validity of one plan on its rounded coordinates, exactly (robust predicates on the doubles):
+/// OGC says no two ring edges may cross or overlap, and a ring may not touch itself; rings of one
+/// plan may touch at points. Returns false and the ring/vertex of a conflict if invalid.
+bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c) {
+  const std::vector<Seg> segs = edges_by_min_x(rings);
   auto pt = [&](std::size_t r, std::size_t i) -> const Point2& { return (*rings[r])[i % rings[r]->size()]; };
   auto on_seg = [](const Point2& a, const Point2& b, const Point2& p) {  // p on closed segment, collinear known
     return std::min(a.x, b.x) <= p.x && p.x <= std::max(a.x, b.x) && std::min(a.y, b.y) <= p.y &&
@@ -137,20 +149,7 @@ bool touch_cycle(const std::vector<std::vector<Point2>*>& rings) {
   if (!any_hole) return false;
   // the graph of rings and touch points, each point one node; an incidence (ring, point) joining two
   // nodes already connected closes a cycle
-  struct Seg {
-    double minx, maxx, miny, maxy;
-    std::size_t ring, edge;
-  };
-  std::vector<Seg> segs;
-  for (std::size_t r = 0; r < rings.size(); ++r) {
-    const auto& R = *rings[r];
-    for (std::size_t i = 0, n = R.size(); i < n; ++i) {
-      const Point2& a = R[i];
-      const Point2& b = R[(i + 1) % n];
-      segs.push_back({std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), r, i});
-    }
-  }
-  std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.minx < y.minx; });
+  const std::vector<Seg> segs = edges_by_min_x(rings);
   auto pt = [&](std::size_t r, std::size_t i) -> const Point2& { return (*rings[r])[i % rings[r]->size()]; };
   // touches: (point, ring) for both rings of every touch; collected first, then deduplicated
   std::vector<std::pair<std::pair<double, double>, std::size_t>> inc;
