@@ -4,6 +4,8 @@
 // architecture.
 #include "pipeline/plan_spill.h"
 
+#include "pipeline/byte_reader.h"
+
 #include <groundplan/error.h>
 
 #include <cpl_conv.h>
@@ -48,24 +50,11 @@ class Writer {
   std::vector<char>& out_;
 };
 
-class Reader {
+class Reader : public ByteReader {
  public:
-  Reader(const char* p, std::size_t n) : p_(p), end_(p + n) {}
-  template <class T>
-  T get() {
-    need(sizeof(T));
-    T v;
-    std::memcpy(&v, p_, sizeof(T));
-    p_ += sizeof(T);
-    return v;
-  }
-  std::string str() {
-    const auto n = get<std::uint32_t>();
-    need(n);
-    std::string s(p_, n);
-    p_ += n;
-    return s;
-  }
+  Reader(const char* p, std::size_t n)
+      : ByteReader(p, n, "tiled run: temporary plan file is corrupt (short record)") {}
+  std::string str() { return ByteReader::str<std::uint32_t>(); }
   Ring ring(bool keep) {
     const auto n = get<std::uint32_t>();
     need(std::size_t{n} * 16);
@@ -90,14 +79,6 @@ class Reader {
     }
     return poly;
   }
-  bool done() const { return p_ == end_; }
-
- private:
-  void need(std::size_t n) const {
-    if (static_cast<std::size_t>(end_ - p_) < n) throw Error("tiled run: temporary plan file is corrupt (short record)");
-  }
-  const char* p_;
-  const char* end_;
 };
 
 std::string temp_directory() {

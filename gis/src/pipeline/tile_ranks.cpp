@@ -51,18 +51,6 @@ void Packer::problems(const std::vector<Problem>& list) {
   }
 }
 
-void Unpacker::need(std::size_t n) const {
-  if (static_cast<std::size_t>(end_ - p_) < n) throw Error("tiled run over ranks: a message from another rank is cut short");
-}
-
-std::string Unpacker::str() {
-  const auto n = static_cast<std::size_t>(get<std::uint64_t>());
-  need(n);
-  std::string s(p_, n);
-  p_ += n;
-  return s;
-}
-
 void Unpacker::problems(std::vector<Problem>& out) {
   const auto n = get<std::uint64_t>();
   for (std::uint64_t i = 0; i < n; ++i) {

@@ -4,6 +4,8 @@
 // input files each rank maps (contiguous runs balanced by bytes), and a flat byte form for counts and problems.
 #include <groundplan/types.h>
 
+#include "pipeline/byte_reader.h"
+
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -32,25 +34,13 @@ class Packer {
 };
 
 /// Reads what a Packer wrote, in the same order; throws Error when the bytes run out.
-class Unpacker {
+class Unpacker : public ByteReader {
  public:
-  Unpacker(const char* p, std::size_t n) : p_(p), end_(p + n) {}
-  template <class T>
-  T get() {
-    need(sizeof(T));
-    T v;
-    std::memcpy(&v, p_, sizeof(T));
-    p_ += sizeof(T);
-    return v;
-  }
-  std::string str();
+  Unpacker(const char* p, std::size_t n)
+      : ByteReader(p, n, "tiled run over ranks: a message from another rank is cut short") {}
+  std::string str() { return ByteReader::str<std::uint64_t>(); }
   /// Appends the problems to `out`.
   void problems(std::vector<Problem>& out);
-
- private:
-  void need(std::size_t n) const;
-  const char* p_;
-  const char* end_;
 };
 
 }  // namespace groundplan::gis::detail
