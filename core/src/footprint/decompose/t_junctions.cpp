@@ -8,6 +8,18 @@
 #include <limits>
 
 namespace groundplan::footprint::detail {
+namespace {
+
+/// Does p lie within sqrt(tol2) of the open edge A + t d (0 < t < 1, L2 = |d|^2)? t: its parameter.
+inline bool inside_edge(const V3& p, const V3& A, const V3& d, double L2, double tol2, double& t) {
+  const V3 ap = p - A;
+  t = dot(ap, d) / L2;
+  if (!(t > 0) || !(t < 1)) return false;
+  const V3 off{ap.x - t * d.x, ap.y - t * d.y, ap.z - t * d.z};
+  return dot(off, off) <= tol2;
+}
+
+}  // namespace
 
 /// Splits every edge seen by one facet at the ends of other such edges lying on it (within tol).
 /// Returns whether anything was split (then the edges must be regrouped).
@@ -67,11 +79,8 @@ bool Decomposer::split_t_junctions() {
     for (; it != ends.end() && it->x <= xhi && nhits < 64; ++it) {
       const std::uint32_t v = it->v;
       if (v == h.a || v == h.b) continue;
-      const V3 ap = P[v] - A;
-      const double t = dot(ap, d) / L2;
-      if (!(t > 0) || !(t < 1)) continue;
-      const V3 off{ap.x - t * d.x, ap.y - t * d.y, ap.z - t * d.z};
-      if (dot(off, off) > tol2) continue;
+      double t = 0;
+      if (!inside_edge(P[v], A, d, L2, tol2, t)) continue;
       hits[nhits++] = Hit{t, v};
     }
     if (nhits == 0) {
@@ -147,11 +156,8 @@ bool Decomposer::open_end_on_open_edge() {
       if (!(x >= xlo)) continue;
       const std::uint32_t v = E[j].id;
       if (v == h.a || v == h.b) continue;
-      const V3 ap = P[v] - A;
-      const double t = dot(ap, d) / L2;
-      if (!(t > 0) || !(t < 1)) continue;
-      const V3 off{ap.x - t * d.x, ap.y - t * d.y, ap.z - t * d.z};
-      if (dot(off, off) > tol2) continue;
+      double t = 0;
+      if (!inside_edge(P[v], A, d, L2, tol2, t)) continue;
       return true;
     }
   }
