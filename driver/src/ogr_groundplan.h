@@ -34,6 +34,10 @@ class OGRGroundPlanLayer final : public OGRLayer {
 
   OGRFeatureDefn* defn() { return defn_; }
 
+  /// Serves only the features of index [first, last) (FIDs first + 1 .. last), e.g. one of several writers'
+  /// share of a layer (the CLI's GeoPackage written in slices, cli/gpkg_slices.h). Counts follow the range.
+  void restrict_to(std::size_t first, std::size_t last);
+
   void ResetReading() override;
   OGRFeature* GetNextFeature() override;
   OGRFeature* GetFeature(GIntBig fid) override;
@@ -51,7 +55,7 @@ class OGRGroundPlanLayer final : public OGRLayer {
   void take_batch(std::size_t first);           // the batch that starts at `first`; then prefetches the next
 
   OGRFeatureDefn* defn_;
-  std::size_t count_;
+  std::size_t begin_ = 0, count_;  // the features served: [begin_, count_)
   Maker make_;
   Extent extent_fn_;
   OGREnvelope extent_;
@@ -82,6 +86,9 @@ class OGRGroundPlanDataSource final : public GDALDataset {
   /// Plans whose building_ids were cut (see max_id_list_chars); a tiled run's are counted as they are written.
   std::size_t id_lists_cut() const;
 
+  /// The layer called `name`, or null.
+  OGRGroundPlanLayer* layer(const char* name);
+
   int GetLayerCount() override { return static_cast<int>(layers_.size()); }
   OGRLayer* GetLayer(int i) override;
   int TestCapability(const char*) override { return FALSE; }
@@ -91,13 +98,15 @@ class OGRGroundPlanDataSource final : public GDALDataset {
   static GDALDataset* Open(GDALOpenInfo* info);
 
  private:
-  std::vector<std::unique_ptr<OGRGroundPlanLayer>> layers_;
+  // Declared before the layers, so destroyed after them: their features' definitions hold srs_, and their
+  // makers (and a batch still being built when the writer stops early, e.g. ogr2ogr -limit) read the result.
   std::shared_ptr<const gis::PipelineResult> result_;
   std::shared_ptr<const gis::TiledResult> tiled_;
   std::shared_ptr<std::vector<std::uint8_t>> cut_flags_;  // tiled: plan i's id list was cut
   std::vector<GIntBig> plan_of_;  // the plan (gp_id) that holds each footprint; 0: none
   OGRSpatialReference srs_;
   std::size_t id_lists_cut_ = 0;
+  std::vector<std::unique_ptr<OGRGroundPlanLayer>> layers_;
 };
 
 /// Registers the driver with GDAL (idempotent). The plugin's RegisterOGRGroundPlan calls it.
