@@ -5,6 +5,7 @@
 #include "ogr_groundplan.h"
 #include "open_options.h"
 #include "gpkg_rtree.h"
+#include "gpkg_slices.h"
 #include "preview.h"
 #ifdef GROUNDPLAN_WITH_MPI
 #include "mpi_exchange.h"
@@ -28,6 +29,7 @@
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <set>
 #include <string>
@@ -304,9 +306,19 @@ using clock = std::chrono::steady_clock;
 
 double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
 
+struct WriteOutcome {
+  bool ok = false;
+  int usage_error = FALSE;
+  bool own_index = false;
+  double write_s = 0, index_s = 0;
+  groundplan::cli::RtreeBuild built;
+  std::string members_note;
+  nlohmann::json writer;  // --stats "writer": how many writers, and why one (gpkg_slices.h)
+};
+
 bool write_stats(const std::string& path, const PipelineResult& result, double write_s, double index_s, double total_s,
                  double cpu_s, const nlohmann::json* verify, const groundplan::LodParams& lod,
-                 const groundplan::cli::RtreeBuild* index = nullptr) {
+                 const WriteOutcome* written = nullptr) {
   nlohmann::json j;
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                  {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
@@ -322,8 +334,9 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   j["reading"] = {{"threads", rs.threads}, {"files", rs.files},       {"bytes", rs.bytes},
                   {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole}};
   j["raster_backend"] = result.raster_backend;
-  if (index)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
-    j["spatial_index"] = spatial_index_json(*index);
+  if (written && written->own_index && written->ok)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
+    j["spatial_index"] = spatial_index_json(written->built);
+  if (written && !written->writer.is_null()) j["writer"] = written->writer;
   if (lod.any()) j["level_of_detail"] = lod_json(lod, result.lod_stats);
   if (verify) j["verify"] = *verify;
   std::ofstream f(path);
@@ -335,29 +348,63 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   return true;
 }
 
-struct WriteOutcome {
-  bool ok = false;
-  int usage_error = FALSE;
-  bool own_index = false;
-  double write_s = 0, index_s = 0;
-  groundplan::cli::RtreeBuild built;
-  std::string members_note;
-};
 
 /// Writes our dataset (taking it: closed here) through GDAL's ogr2ogr with the user's options, packs a new
 /// GeoPackage's spatial index, and writes the full member lists beside a DBF whose id lists were cut.
-WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads) {
+/// `another`, where given, makes one more dataset like `ds` (the one-process result): a new GeoPackage is then
+/// written by several writers side by side (gpkg_slices.h).
+WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads,
+                          const std::function<groundplan::driver::OGRGroundPlanDataSource*(int threads)>& another = {}) {
   WriteOutcome w;
   const bool dbf = writes_dbf(ogr);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
-  std::vector<std::string> vt_args = ogr.options;
   const bool own_index = packs_gpkg_index(ogr);
   w.own_index = own_index;
-  if (own_index) vt_args.insert(vt_args.end(), {"-lco", "SPATIAL_INDEX=NO"});
-  if (!ogr.layer_named) vt_args.push_back("ground_plans");
+  // ogr2ogr's options without the layer names (they come last), then the layers.
+  std::vector<std::string> flags(ogr.options.begin(),
+                                 ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size()));
+  if (own_index) flags.insert(flags.end(), {"-lco", "SPATIAL_INDEX=NO"});
+  const std::vector<std::string> layers = ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+  std::vector<std::string> vt_args = flags;
+  vt_args.insert(vt_args.end(), layers.begin(), layers.end());
   const auto t_write = clock::now();
   int usage_error = FALSE;
-  bool write_ok = vector_translate(ogr.dst, src_h, vt_args, ogr.progress && !ogr.quiet, &usage_error);
+  bool write_ok = false;
+  const int n_threads = static_cast<int>(groundplan::gis::thread_count(threads));
+  std::string why_one = "not a new GeoPackage";
+  int writers = 1;
+  if (own_index && another) {
+    auto* plans_layer = ds->layer("ground_plans");
+    writers = groundplan::cli::gpkg_writers(flags, layers, "ground_plans",
+                                            plans_layer ? static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE)) : 0,
+                                            n_threads, &why_one);
+    if (writers > 1) {
+      groundplan::cli::SliceWrite sw;
+      sw.dst = ogr.dst;
+      sw.flags = flags;
+      sw.layers = layers;
+      sw.plans = static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE));
+      sw.writers = writers;
+      sw.progress = ogr.progress && !ogr.quiet;
+      const int per_writer = std::max(1, n_threads / writers);
+      const auto slice = groundplan::cli::write_gpkg_slices(
+          sw,
+          [&](std::size_t first, std::size_t last) -> GDALDatasetH {
+            auto* d = another(per_writer);
+            d->layer("ground_plans")->restrict_to(first, last);
+            return GDALDataset::ToHandle(d);
+          },
+          vector_translate);
+      write_ok = slice.ok;
+      usage_error = slice.usage_error;
+      if (!slice.ok) std::fprintf(stderr, "groundplan: %s\n", slice.error.c_str());
+      w.writer = {{"writers", writers}, {"slices_s", slice.slices_s}, {"append_s", slice.merge_s}};
+    }
+  }
+  if (writers == 1) {
+    write_ok = vector_translate(ogr.dst, src_h, vt_args, ogr.progress && !ogr.quiet, &usage_error);
+    w.writer = {{"writers", 1}, {"why_one", why_one}};
+  }
   double index_s = 0;
   groundplan::cli::RtreeBuild& built = w.built;
   if (write_ok && own_index) {
@@ -714,13 +761,14 @@ int run(int argc, char** argv, Ranks* ranks) {
   }
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
-  auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
-                                                             result_ptr, writes_dbf(ogr) ? 254 : 0, options.threads);
-  const WriteOutcome w = write_output(ds, ogr, options.threads);
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
+  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
+  auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, options.threads);
+  const WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
+    return new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, threads);
+  });
   const bool write_ok = w.ok;
   const double write_s = w.write_s, index_s = w.index_s;
-  const groundplan::cli::RtreeBuild& built = w.built;
-  const bool own_index = w.own_index;
   const std::string& members_note = w.members_note;
   const double total_s = seconds_since(t0), cpu_s = groundplan::gis::process_cpu_seconds() - cpu0;  // before --verify and --preview
   if (!write_ok) {
@@ -775,7 +823,7 @@ int run(int argc, char** argv, Ranks* ranks) {
     if (!ok) rc = 3;
   }
   if (!stats_path.empty() && !write_stats(stats_path, result, write_s, index_s, total_s, cpu_s, verify ? &verify_json : nullptr,
-                                          options.detail, own_index && write_ok ? &built : nullptr))
+                                          options.detail, &w))
     return 1;
   return rc;
 }

@@ -234,6 +234,12 @@ OGRLayer* OGRGroundPlanDataSource::GetLayer(int i) {
   return layers_[static_cast<std::size_t>(i)].get();
 }
 
+OGRGroundPlanLayer* OGRGroundPlanDataSource::layer(const char* name) {
+  for (auto& l : layers_)
+    if (EQUAL(l->GetName(), name)) return l.get();
+  return nullptr;
+}
+
 int OGRGroundPlanDataSource::Identify(GDALOpenInfo* info) {
   return STARTS_WITH_CI(info->pszFilename, kPrefix) ? TRUE : FALSE;
 }

@@ -31,6 +31,15 @@ OGRGroundPlanLayer::~OGRGroundPlanLayer() {
   defn_->Release();
 }
 
+void OGRGroundPlanLayer::restrict_to(std::size_t first, std::size_t last) {
+  ResetReading();
+  next_batch_.clear();
+  last = std::min(last, count_);
+  begin_ = std::min(first, last);
+  count_ = last;
+  batch_first_ = begin_;
+}
+
 void OGRGroundPlanLayer::build(Batch& batch, std::size_t first) {
   const std::size_t n = std::min(kBatch, count_ - first);
   batch.clear();
@@ -68,7 +77,8 @@ void OGRGroundPlanLayer::take_batch(std::size_t first) {
 void OGRGroundPlanLayer::ResetReading() {
   wait_prefetch();
   batch_.clear();
-  batch_first_ = batch_pos_ = 0;
+  batch_first_ = begin_;
+  batch_pos_ = 0;
 }
 
 bool OGRGroundPlanLayer::passes_filters(OGRFeature* f) {
@@ -89,14 +99,14 @@ OGRFeature* OGRGroundPlanLayer::GetNextFeature() {
 }
 
 OGRFeature* OGRGroundPlanLayer::GetFeature(GIntBig fid) {
-  if (fid < 1 || fid > static_cast<GIntBig>(count_)) return nullptr;
+  if (fid <= static_cast<GIntBig>(begin_) || fid > static_cast<GIntBig>(count_)) return nullptr;
   OGRFeature* f = make_(defn_, static_cast<std::size_t>(fid - 1));
   f->SetFID(fid);
   return f;
 }
 
 GIntBig OGRGroundPlanLayer::GetFeatureCount(int force) {
-  if (m_poFilterGeom == nullptr && m_poAttrQuery == nullptr) return static_cast<GIntBig>(count_);
+  if (m_poFilterGeom == nullptr && m_poAttrQuery == nullptr) return static_cast<GIntBig>(count_ - begin_);
   return OGRLayer::GetFeatureCount(force);
 }
 

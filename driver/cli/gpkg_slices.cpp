@@ -1,0 +1,207 @@
+// SPDX-License-Identifier: MIT
+#include "gpkg_slices.h"
+
+#include "sqlite_db.h"
+
+#include <cpl_conv.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cctype>
+#include <filesystem>
+#include <set>
+#include <thread>
+#include <unistd.h>
+
+namespace groundplan::cli {
+namespace {
+
+// Plans a writer at least: below this, a second GDAL writer costs more than it saves.
+constexpr std::size_t kPlansPerWriter = 8192;
+// Writers at most: past this the appending (serial) is most of the time.
+constexpr int kMaxWriters = 16;
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// The ogr2ogr options that act on each feature alone (so a slice of the features gives a slice of the
+/// output), with how many values follow them. Anything else (-where on our FIDs, -sql, -limit, -fid,
+/// -explodecollections, -preserve_fid, -unsetFid, -append ...) keeps one writer.
+int per_feature_arity(const std::string& opt) {
+  static const std::set<std::string> none = {"-progress", "-q", "-quiet", "-overwrite", "-skipfailures"};
+  static const std::set<std::string> one = {"-f", "-of", "-lco", "-dsco", "-nln", "-nlt", "-t_srs", "-a_srs", "-gt"};
+  if (none.count(opt)) return 0;
+  if (one.count(opt)) return 1;
+  if (opt == "--config") return 2;
+  return -1;
+}
+
+std::string table_name(const std::vector<std::string>& flags, const std::string& plans_layer) {
+  std::string name = plans_layer;
+  for (std::size_t i = 0; i + 1 < flags.size(); ++i)
+    if (flags[i] == "-nln") name = flags[i + 1];
+  return name;
+}
+
+void remove_with_sidecars(const std::string& path) {
+  std::error_code ec;
+  for (const char* suffix : {"", "-journal", "-wal", "-shm"}) std::filesystem::remove(path + suffix, ec);
+}
+
+/// Appends the rows of the attached `part`'s table to the destination's (same schema, FIDs after the
+/// destination's) and widens the destination's extent.
+void append_part(const sqlite::Db& db, const std::string& part, const std::string& table) {
+  using sqlite::id;
+  using sqlite::lit;
+  auto columns = [&](const std::string& schema) {
+    std::vector<std::string> cols;
+    sqlite::Stmt s(db, "PRAGMA " + schema + ".table_info(" + id(table) + ")");
+    while (s.row()) cols.push_back(s.text(1) + " " + s.text(2) + " " + s.text(3) + " " + s.text(5));
+    return cols;
+  };
+  if (columns("main") != columns("part") || columns("main").empty())
+    throw sqlite::Failure(part + ": the slice's table " + table + " is not the destination's");
+  db.exec("INSERT INTO main." + id(table) + " SELECT * FROM part." + id(table));
+  // gpkg_contents: the extent of all slices (min/max skip the NULLs of a slice without geometry).
+  std::string set;
+  for (const char* c : {"min_x", "min_y", "max_x", "max_y"}) {
+    const std::string agg = c[1] == 'i' ? "min" : "max";
+    set += std::string(set.empty() ? "" : ", ") + c + " = (SELECT " + agg + "(v) FROM (SELECT main.gpkg_contents." + c +
+           " AS v UNION ALL SELECT " + c + " FROM part.gpkg_contents WHERE lower(table_name) = lower(" + lit(table) +
+           ")))";
+  }
+  db.exec("UPDATE main.gpkg_contents SET " + set + " WHERE lower(table_name) = lower(" + lit(table) + ")");
+}
+
+/// Appends the parts to `dst` in order, a transaction each (SQLite detaches a database only outside one); the
+/// table's triggers (GDAL's feature-count triggers) are taken off while the rows go in and put back after, with
+/// the count set once. The caller removes `dst` when this throws.
+void merge(const std::string& dst, const std::vector<std::string>& parts, const std::string& table) {
+  using sqlite::id;
+  using sqlite::lit;
+  sqlite::Db db(dst);
+  std::vector<std::array<std::string, 2>> triggers;
+  {
+    sqlite::Stmt s(db, "SELECT name, sql FROM sqlite_master WHERE type = 'trigger' AND lower(tbl_name) = lower(" +
+                           lit(table) + ")");
+    while (s.row()) triggers.push_back({s.text(0), s.text(1)});
+  }
+  bool has_ogr_contents = false;
+  {
+    sqlite::Stmt s(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'gpkg_ogr_contents'");
+    has_ogr_contents = s.row();
+  }
+  // The file is only handed over after the last commit, which syncs it; the appends need not each.
+  db.exec("PRAGMA synchronous = OFF");
+  for (const auto& t : triggers) db.exec("DROP TRIGGER " + id(t[0]));
+  for (const std::string& part : parts) {
+    db.exec("ATTACH DATABASE " + lit(part) + " AS part");
+    try {
+      db.exec("BEGIN");
+      append_part(db, part, table);
+      db.exec("COMMIT");
+    } catch (...) {
+      db.exec("ROLLBACK");
+      db.exec("DETACH DATABASE part");
+      throw;
+    }
+    db.exec("DETACH DATABASE part");
+  }
+  db.exec("PRAGMA synchronous = FULL");
+  db.exec("BEGIN");
+  if (has_ogr_contents)
+    db.exec("UPDATE gpkg_ogr_contents SET feature_count = (SELECT count(*) FROM " + id(table) +
+            ") WHERE lower(table_name) = lower(" + lit(table) + ")");
+  for (const auto& t : triggers) db.exec(t[1]);
+  db.exec("COMMIT");
+}
+
+}  // namespace
+
+int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
+                 const std::string& plans_layer, std::size_t plans, int threads, std::string* why_one) {
+  auto one = [&](std::string why) {
+    if (why_one) *why_one = std::move(why);
+    return 1;
+  };
+  const int by_plans = static_cast<int>(std::min<std::size_t>(plans / kPlansPerWriter, kMaxWriters));
+  const int writers = std::min(threads, by_plans);
+  if (writers < 2)
+    return one(threads < 2 ? "one thread" : "fewer than " + std::to_string(2 * kPlansPerWriter) + " plans");
+  if (std::none_of(layers.begin(), layers.end(), [&](const std::string& l) { return lower(l) == lower(plans_layer); }))
+    return one("the " + plans_layer + " layer is not written");
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    const int n = per_feature_arity(flags[i]);
+    if (n < 0) return one("ogr2ogr option " + flags[i]);
+    if (flags[i] == "-nln" && layers.size() > 1) return one("-nln with several layers");
+    i += static_cast<std::size_t>(n);
+  }
+  return writers;
+}
+
+SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate) {
+  using clock = std::chrono::steady_clock;
+  SliceOutcome out;
+  const int k_max = std::max(1, w.writers);
+  const std::filesystem::path dst(w.dst);
+  std::vector<std::string> parts;  // slices 1 .. k_max - 1
+  for (int k = 1; k < k_max; ++k)
+    parts.push_back((dst.parent_path() / ("." + dst.stem().string() + ".slice" + std::to_string(k) + "-" +
+                                          std::to_string(::getpid()) + ".gpkg"))
+                        .string());
+  for (const auto& p : parts) remove_with_sidecars(p);
+
+  const auto t0 = clock::now();
+  std::vector<char> ok(static_cast<std::size_t>(k_max), 0);
+  std::vector<int> usage(static_cast<std::size_t>(k_max), 0);
+  auto write_slice = [&](int k) {
+    const std::size_t first = w.plans * static_cast<std::size_t>(k) / static_cast<std::size_t>(k_max);
+    const std::size_t last = w.plans * static_cast<std::size_t>(k + 1) / static_cast<std::size_t>(k_max);
+    GDALDatasetH src = source(first, last);
+    if (!src) return;
+    std::vector<std::string> args = w.flags;
+    args.push_back("-preserve_fid");  // the source's FIDs are the plans' indices + 1: slices append in order
+    if (k == 0)
+      args.insert(args.end(), w.layers.begin(), w.layers.end());
+    else
+      args.push_back(w.plans_layer);
+    int ue = 0;
+    ok[static_cast<std::size_t>(k)] =
+        translate(k == 0 ? w.dst : parts[static_cast<std::size_t>(k - 1)], src, args, w.progress && k == 0, &ue);
+    usage[static_cast<std::size_t>(k)] = ue;
+    GDALClose(src);
+  };
+  {
+    std::vector<std::thread> threads;
+    for (int k = 1; k < k_max; ++k) threads.emplace_back(write_slice, k);
+    write_slice(0);
+    for (auto& t : threads) t.join();
+  }
+  out.slices_s = std::chrono::duration<double>(clock::now() - t0).count();
+  out.usage_error = *std::max_element(usage.begin(), usage.end());
+
+  auto fail = [&](std::string why) {
+    out.error = std::move(why);
+    for (const auto& p : parts) remove_with_sidecars(p);
+    remove_with_sidecars(w.dst);
+    return out;
+  };
+  for (int k = 0; k < k_max; ++k)
+    if (!ok[static_cast<std::size_t>(k)]) return fail("writing slice " + std::to_string(k) + " of the plans failed");
+
+  const auto t1 = clock::now();
+  try {
+    merge(w.dst, parts, table_name(w.flags, w.plans_layer));
+  } catch (const std::exception& e) {
+    return fail(std::string("appending the slices failed: ") + e.what());
+  }
+  out.merge_s = std::chrono::duration<double>(clock::now() - t1).count();
+  for (const auto& p : parts) remove_with_sidecars(p);
+  out.ok = true;
+  return out;
+}
+
+}  // namespace groundplan::cli

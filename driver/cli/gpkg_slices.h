@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// A new GeoPackage written by several GDAL writers at once (issue 14).
+//
+// GDAL's GeoPackage writer is one thread (one SQLite connection): at city scale it was the longest serial
+// stage left (121,856 plans: 1.2-1.5 s of a 3.5 s run on 16 cores, RESULTS.md). Here the plans layer is cut
+// into contiguous slices of features; each slice is written by its own ogr2ogr (GDALVectorTranslate, the
+// user's options unchanged, FIDs kept) into its own file, slice 0 straight into the destination together with
+// the other layers asked for; then the other slices' rows are appended to the destination's table in slice
+// order by SQLite itself (one INSERT ... SELECT a slice, which SQLite copies record by record), and the
+// table's extent and feature count are set for all of them. What a reader gets is what one writer gives:
+// the same tables, schema, rows, FIDs (1..N in plan order), extent and count; only the file's page layout
+// differs. The spatial index is packed afterwards as for any new GeoPackage (gpkg_rtree.h).
+#include <gdal.h>
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace groundplan::cli {
+
+/// How many writers a new GeoPackage gets; 1 (and `why_one` says why) when it is written by one writer as
+/// before: few plans or threads, or an ogr2ogr option whose effect spans features (-where, -sql, -limit,
+/// -explodecollections ...). `flags`: the ogr2ogr options without the layer names.
+int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
+                 const std::string& plans_layer, std::size_t plans, int threads, std::string* why_one);
+
+/// A dataset whose plans layer serves the plans [first, last) only (and the other layers whole); the callee
+/// closes it with GDALClose.
+using SliceSource = std::function<GDALDatasetH(std::size_t first, std::size_t last)>;
+/// Runs GDAL's ogr2ogr (the CLI's vector_translate): false on failure, GDAL having said why.
+using Translate = std::function<bool(const std::string& dst, GDALDatasetH src, const std::vector<std::string>& args,
+                                     bool progress, int* usage_error)>;
+
+struct SliceWrite {
+  std::string dst;                  // a GeoPackage that does not exist yet
+  std::vector<std::string> flags;   // ogr2ogr options, no layer names
+  std::vector<std::string> layers;  // what slice 0 writes (the plans layer among them)
+  std::string plans_layer = "ground_plans";
+  std::size_t plans = 0;            // features of the plans layer
+  int writers = 2;
+  bool progress = false;            // slice 0 reports progress
+};
+
+struct SliceOutcome {
+  bool ok = false;
+  int usage_error = 0;
+  std::string error;                // non-empty: what failed (the destination has been removed)
+  double slices_s = 0, merge_s = 0;  // writing the slices side by side; appending them to the destination
+};
+
+/// Writes `w.dst` with `w.writers` writers side by side (see above). On failure nothing is left under
+/// `w.dst` nor beside it.
+SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate);
+
+}  // namespace groundplan::cli

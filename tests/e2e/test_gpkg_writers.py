@@ -1,0 +1,125 @@
+# SPDX-License-Identifier: MIT
+"""A new GeoPackage written by several writers side by side (issue 14, driver/cli/gpkg_slices.h) is the file one
+writer makes, seen from any reader: the same schema, rows (FID, every field, the geometry blob byte for byte),
+extent, feature count and spatial index; no slice file is left beside it. Options whose effect spans features
+keep one writer, and --stats says which was used and why."""
+import json
+import sqlite3
+
+import pytest
+from osgeo import gdal
+
+from conftest import BIN, run
+
+packs_index = int(gdal.VersionInfo()) < 3070000  # the slices are the CLI's only where it packs the index too
+pytestmark = pytest.mark.skipif(not packs_index, reason="GDAL >= 3.7 writes GeoPackages its own way")
+
+SCHEMA = "SELECT type, name, tbl_name, sql FROM sqlite_master ORDER BY type, name"
+CONTENTS = "SELECT table_name, data_type, identifier, min_x, min_y, max_x, max_y, srs_id FROM gpkg_contents ORDER BY 1"
+
+
+def square(x, y, s):
+    return [[x, y], [x + s, y], [x + s, y + s], [x, y + s], [x, y]]
+
+
+@pytest.fixture(scope="module")
+def parts(tmp_path_factory):
+    """About 44,000 building parts in EPSG:25832 (a grid of squares, some overlapping a neighbour, some with a
+    courtyard) and a few degenerate ones (problems): about 35,000 plans (pairs of cells joined), enough for four writers."""
+    features = []
+    for i in range(220):
+        for j in range(180):
+            x, y = 400000.0 + 10 * i, 5800000.0 + 10 * j
+            rings = [square(x, y, 8.0)]
+            if (i * j) % 13 == 5:
+                rings.append(square(x + 3, y + 3, 2.0)[::-1])
+            features.append({"type": "Feature", "properties": {"id": f"b{i}_{j}"},
+                             "geometry": {"type": "Polygon", "coordinates": rings}})
+            if (i + j) % 9 == 0:  # a second part overlapping this one and the next cell's
+                features.append({"type": "Feature", "properties": {"id": f"p{i}_{j}"},
+                                 "geometry": {"type": "Polygon", "coordinates": [square(x + 5, y + 2, 6.5)]}})
+    for k in range(5):  # no area: each a problem, nothing written for it
+        x = 399000.0 + 10 * k
+        features.append({"type": "Feature", "properties": {"id": f"flat{k}"},
+                         "geometry": {"type": "Polygon", "coordinates": [[[x, 0], [x + 1, 0], [x + 2, 0], [x, 0]]]}})
+    path = tmp_path_factory.mktemp("writers") / "parts.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection",
+                                "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::25832"}},
+                                "features": features}))
+    return path
+
+
+def write(folder, name, src, threads, *args):
+    out, stats = folder / f"{name}.gpkg", folder / f"{name}.json"
+    run([BIN, "-q", "--threads", str(threads), "--stats", stats, "-f", "GPKG", out, src, *args])
+    return out, json.loads(stats.read_text())
+
+
+def same_file_content(a_path, b_path, tables):
+    a, b = sqlite3.connect(a_path), sqlite3.connect(b_path)
+    assert list(a.execute(SCHEMA)) == list(b.execute(SCHEMA))
+    assert list(a.execute(CONTENTS)) == list(b.execute(CONTENTS))
+    assert list(a.execute("SELECT * FROM gpkg_ogr_contents ORDER BY 1")) == \
+        list(b.execute("SELECT * FROM gpkg_ogr_contents ORDER BY 1"))
+    for t in tables:
+        rows = list(a.execute(f'SELECT * FROM "{t}" ORDER BY fid'))
+        assert rows == list(b.execute(f'SELECT * FROM "{t}" ORDER BY fid')), t
+        assert [r[0] for r in rows] == list(range(1, len(rows) + 1)), f"{t}: FIDs are not 1..N in order"
+        count = a.execute("SELECT feature_count FROM gpkg_ogr_contents WHERE table_name = ?", (t,)).fetchone()[0]
+        assert count == len(rows)
+    assert a.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
+
+
+def test_slices_give_the_one_writer_file(tmp_path, parts):
+    one, one_stats = write(tmp_path, "one", parts, 1)
+    many, many_stats = write(tmp_path, "many", parts, 4)
+    assert one_stats["writer"] == {"writers": 1, "why_one": "one thread"}
+    assert many_stats["writer"]["writers"] == 4, many_stats["writer"]
+    plans = many_stats["counts"]["ground_plans"]
+    assert plans > 4 * 8192 and plans == one_stats["counts"]["ground_plans"]
+    same_file_content(many, one, ["ground_plans"])
+    db = sqlite3.connect(many)
+    assert db.execute("SELECT count(*) FROM ground_plans").fetchone()[0] == plans
+    assert db.execute("SELECT count(*) FROM rtree_ground_plans_geom").fetchone()[0] == plans
+    assert db.execute("SELECT rtreecheck('rtree_ground_plans_geom')").fetchone()[0] == "ok"
+    # The triggers are back: a row added by a GDAL user is counted and indexed.
+    ds = gdal.OpenEx(str(many), gdal.OF_VECTOR | gdal.OF_UPDATE)
+    lyr = ds.GetLayer("ground_plans")
+    from osgeo import ogr
+    f = ogr.Feature(lyr.GetLayerDefn())
+    f.SetGeometry(ogr.CreateGeometryFromWkt("POLYGON ((1 1, 2 1, 2 2, 1 1))"))
+    assert lyr.CreateFeature(f) == 0
+    ds = None
+    db = sqlite3.connect(many)
+    assert db.execute("SELECT feature_count FROM gpkg_ogr_contents WHERE table_name = 'ground_plans'").fetchone()[0] \
+        == plans + 1
+    assert db.execute("SELECT count(*) FROM rtree_ground_plans_geom").fetchone()[0] == plans + 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["many.gpkg", "many.json", "one.gpkg", "one.json"], \
+        "a slice file was left behind"
+
+
+def test_other_layers_and_a_new_name(tmp_path, parts):
+    layers = ["ground_plans", "problems", "plan_members"]
+    one, _ = write(tmp_path, "one", parts, 1, *layers)
+    many, stats = write(tmp_path, "many", parts, 4, *layers)
+    assert stats["writer"]["writers"] == 4
+    assert stats["counts"]["problems"] >= 5
+    same_file_content(many, one, layers)
+    one, _ = write(tmp_path, "one_nln", parts, 1, "-nln", "blocks")
+    many, stats = write(tmp_path, "many_nln", parts, 3, "-nln", "blocks")
+    assert stats["writer"]["writers"] == 3
+    same_file_content(many, one, ["blocks"])
+
+
+@pytest.mark.parametrize("option", [["-where", "n_parts > 1"], ["-limit", "100"], ["-preserve_fid"]],
+                         ids=lambda o: o[0])
+def test_options_across_features_keep_one_writer(tmp_path, parts, option):
+    many, stats = write(tmp_path, "many", parts, 4, *option)
+    assert stats["writer"] == {"writers": 1, "why_one": f"ogr2ogr option {option[0]}"}
+    rows = sqlite3.connect(many).execute("SELECT count(*) FROM ground_plans").fetchone()[0]
+    if option[0] == "-limit":  # ogr2ogr stops reading early: the CLI once freed the layers in the wrong order
+        assert rows == 100
+    elif option[0] == "-where":
+        assert 0 < rows < stats["counts"]["ground_plans"]
+    else:
+        assert rows == stats["counts"]["ground_plans"]
