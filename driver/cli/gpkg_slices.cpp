@@ -121,6 +121,8 @@ void merge(const std::string& dst, const std::vector<std::string>& parts, const 
 
 }  // namespace
 
+void sqlite_without_memory_statistics() { sqlite3_config(SQLITE_CONFIG_MEMSTATUS, 0); }
+
 int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
                  const std::string& plans_layer, std::size_t plans, int threads, std::string* why_one) {
   auto one = [&](std::string why) {

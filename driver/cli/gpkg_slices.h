@@ -20,6 +20,11 @@
 
 namespace groundplan::cli {
 
+/// SQLite keeps process-wide memory statistics behind one global mutex, taken by every allocation of every
+/// connection: writers side by side wait on it. Turns them off; call before SQLite is first used (first
+/// thing in main). SQLite's own limits that rely on them (soft heap limit) are not used here.
+void sqlite_without_memory_statistics();
+
 /// How many writers a new GeoPackage gets; 1 (and `why_one` says why) when it is written by one writer as
 /// before: few plans or threads, or an ogr2ogr option whose effect spans features (-where, -sql, -limit,
 /// -explodecollections ...). `flags`: the ogr2ogr options without the layer names.
