@@ -391,6 +391,10 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
           sw,
           [&](std::size_t first, std::size_t last) -> GDALDatasetH {
             auto* d = another(per_writer);
+            if (!d || !d->layer("ground_plans")) {
+              delete d;
+              return nullptr;  // that slice fails, and so the write (gpkg_slices.h)
+            }
             d->layer("ground_plans")->restrict_to(first, last);
             return GDALDataset::ToHandle(d);
           },
@@ -500,7 +504,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
 #endif
   if (!result) result = groundplan::gis::run_pipeline_tiled(options, progress);
   const groundplan::gis::TiledResult& r = *result;
-  auto stats = [&](double write_s, double index_s, const groundplan::cli::RtreeBuild* index) {
+  auto stats = [&](double write_s, double index_s, const WriteOutcome* written) {
     if (stats_path.empty()) return true;
     const groundplan::gis::TileStats& t = r.tiles;
     nlohmann::json j;
@@ -529,8 +533,8 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
                   {"rank0_peak_rss_after_write_bytes", static_cast<std::uint64_t>(u.ru_maxrss) * 1024}};
     }
     j["raster_backend"] = r.raster_backend;
-    if (index)
-      j["spatial_index"] = spatial_index_json(*index);
+    if (written && written->own_index && written->ok) j["spatial_index"] = spatial_index_json(written->built);
+    if (written && !written->writer.is_null()) j["writer"] = written->writer;
     std::ofstream f(stats_path);
     f << j.dump(2) << '\n';
     if (!f) std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());
@@ -545,9 +549,13 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
     stats(0, 0, nullptr);
     return finish(1);
   }
-  auto* ds = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
-                                                             result, writes_dbf(ogr) ? 254 : 0, options.threads);
-  const WriteOutcome w = write_output(ds, ogr, options.threads);
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
+  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
+  auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, options.threads);
+  // Plans are read back from the run's spill by position: datasets side by side may read it at once.
+  const WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
+    return new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, threads);
+  });
   if (!w.ok) {
     std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr_in.dst.c_str(),
                  w.usage_error ? " (bad ogr2ogr options)" : "");
@@ -555,7 +563,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   }
   if (!w.members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", w.members_note.c_str());
   // Over ranks the dataset is in place only now: "wrote" is said after that.
-  const int rc = finish(stats(w.write_s, w.index_s, w.own_index ? &w.built : nullptr) ? 0 : 1);
+  const int rc = finish(stats(w.write_s, w.index_s, &w) ? 0 : 1);
   if (!ogr.quiet) {
     const groundplan::gis::TileStats& t = r.tiles;
     std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles%s\n", r.buildings_read, ogr.src.c_str(),

@@ -123,3 +123,20 @@ def test_options_across_features_keep_one_writer(tmp_path, parts, option):
         assert 0 < rows < stats["counts"]["ground_plans"]
     else:
         assert rows == stats["counts"]["ground_plans"]
+
+
+def test_tiled_run_slices_too(tmp_path, parts):
+    """The tiled run (--tiles on, and so rank 0 over MPI) reads its plans back from the spill: writers side by side
+    read it at once, and the file is the one-writer file."""
+    data = json.loads(parts.read_text())
+    tiles = tmp_path / "tiles"
+    tiles.mkdir()
+    n = len(data["features"])
+    for k in range(3):  # the parts in three files, cut inside rows of the grid: plans cross the cuts
+        part = dict(data, features=data["features"][k * n // 3:(k + 1) * n // 3])
+        (tiles / f"t{k}.geojson").write_text(json.dumps(part))
+    one, one_stats = write(tmp_path, "one", tiles, 1, "--tiles", "on")
+    many, many_stats = write(tmp_path, "many", tiles, 4, "--tiles", "on")
+    assert many_stats["writer"]["writers"] == 4 and one_stats["writer"]["writers"] == 1
+    assert many_stats["tiles"]["seam_plans"] > 0
+    same_file_content(many, one, ["ground_plans"])
