@@ -10,10 +10,8 @@ set -u
 BUNDLE=${1:?BUNDLE}; MB=${2:-1500}; BIG_MB=${3:-0}
 OUT=${OUT:-city-scale-out}; mkdir -p "$OUT"
 exec > >(tee "$OUT/city_scale.log") 2>&1
-W=/tmp/gp-city; rm -rf "$W"; mkdir -p "$W"
-xz -dc "$BUNDLE" | tar -C "$W" -xf - || { echo "cannot unpack $BUNDLE"; exit 1; }
-G=$W/gp
-export LD_LIBRARY_PATH=$G/lib GDAL_DATA=$G/share/gdal PROJ_DATA=$G/share/proj PROJ_LIB=$G/share/proj
+W=/tmp/gp-city
+source "$(dirname "$0")/../gpu/unpack_bundle.sh"
 echo "== machine"; date -u; nproc; lscpu | grep -E "Model name|^Thread|^Core|^Socket|^NUMA node\(s\)|MHz"; free -g | head -2
 $G/bin/groundplan --version || { ldd $G/bin/groundplan | grep "not found"; exit 1; }
 

@@ -11,10 +11,8 @@ set -u
 BUNDLE=${1:?BUNDLE}; MB=${2:-1500}; ROUNDS=${3:-3}
 OUT=${OUT:-gpkg-writers-out}; mkdir -p "$OUT"
 exec > >(tee "$OUT/gpkg_writers.log") 2>&1
-W=/tmp/gp-writers; rm -rf "$W"; mkdir -p "$W"
-xz -dc "$BUNDLE" | tar -C "$W" -xf - || { echo "cannot unpack $BUNDLE"; exit 1; }
-G=$W/gp
-export LD_LIBRARY_PATH=$G/lib GDAL_DATA=$G/share/gdal PROJ_DATA=$G/share/proj PROJ_LIB=$G/share/proj
+W=/tmp/gp-writers
+source "$(dirname "$0")/../gpu/unpack_bundle.sh"
 echo "== machine"; date -u; nproc; lscpu | grep -E "Model name|^Thread|^Core|^Socket"; free -g | head -2
 
 gp() {  # NAME ARGS... : one run, one line

@@ -9,10 +9,8 @@ set -u
 BUNDLE=${1:?BUNDLE}; BIG_MB=${2:-150}
 OUT=${OUT:-gpu-e2e-out}; mkdir -p "$OUT"
 exec > >(tee "$OUT/e2e.log") 2>&1
-W=/tmp/gp-e2e; rm -rf "$W"; mkdir -p "$W"
-xz -dc "$BUNDLE" | tar -C "$W" -xf - || { echo "cannot unpack $BUNDLE"; exit 1; }
-G=$W/gp
-export LD_LIBRARY_PATH=$G/lib GDAL_DATA=$G/share/gdal PROJ_DATA=$G/share/proj PROJ_LIB=$G/share/proj
+W=/tmp/gp-e2e
+source "$(dirname "$0")/./unpack_bundle.sh"
 echo "== machine"; date -u; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; nproc; lscpu | grep -m1 "Model name"
 $G/bin/groundplan --version || { echo "the packed CLI does not start:"; ldd $G/bin/groundplan | grep "not found"; exit 1; }
 echo "== a large city: tests/bench/gen_big_citygml.py $BIG_MB MB"
