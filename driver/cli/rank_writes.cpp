@@ -94,6 +94,21 @@ class HeldTransaction final : public GDALDataset {
   GDALDataset* real_;
 };
 
+/// How long a rank's statement may wait for a lock. The ranks' rows never share a key, so an append waits for
+/// nothing; but two uncommitted rows with one key make the second insert wait for the first transaction, which
+/// waits (in the exchange of outcomes) for the second rank: a deadlock PostgreSQL cannot see. A timeout turns it
+/// into an error every rank learns. Only a fault (ids given twice) gets there.
+constexpr const char* kLockTimeout = "60s";
+
+/// SET lock_timeout on the rank's connection; false when the server refuses.
+bool wait_for_locks_at_most(GDALDatasetH dst, const char* timeout) {
+  CPLErrorReset();
+  const std::string sql = std::string("SET lock_timeout = '") + timeout + "'";
+  OGRLayerH rs = GDALDatasetExecuteSQL(dst, sql.c_str(), nullptr, nullptr);
+  if (rs) GDALDatasetReleaseResultSet(dst, rs);
+  return CPLGetLastErrorType() < CE_Failure;
+}
+
 /// The -doo NAME=VALUE open options among the user's options.
 CPLStringList open_options(const std::vector<std::string>& options) {
   CPLStringList out;
@@ -161,6 +176,8 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   bool in_transaction = false;
   if (!dst) {
     wrote = "cannot open " + setup.dst + ": " + gdal_error("no PostgreSQL datasource");
+  } else if (!wait_for_locks_at_most(dst, kLockTimeout)) {
+    wrote = "cannot set lock_timeout: " + gdal_error("the server refused");
   } else if (GDALDatasetStartTransaction(dst, FALSE) != OGRERR_NONE) {
     wrote = "cannot start a transaction: " + gdal_error("the driver refused");
   } else {

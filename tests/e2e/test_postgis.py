@@ -94,7 +94,7 @@ class Server:
         return name, f"PG:host={self.dir} dbname={name} user=postgres"
 
     def stop(self):
-        subprocess.run(self.as_user + [f"{self.bin}/pg_ctl", "-D", self.data, "-m", "fast", "-w", "stop"],
+        subprocess.run(self.as_user + [f"{self.bin}/pg_ctl", "-D", self.data, "-m", "immediate", "-w", "stop"],
                        capture_output=True, timeout=120)
         shutil.rmtree(self.dir, ignore_errors=True)
 
