@@ -120,7 +120,7 @@ CPLStringList open_options(const std::vector<std::string>& options) {
 }  // namespace
 
 bool written_by_every_rank(const std::string& format, const std::string& dst) {
-  if (!format.empty()) return lower(format) == "postgresql" || lower(format) == "pg";
+  if (!format.empty()) return lower(format) == "postgresql";
   return dst.rfind("PG:", 0) == 0 || dst.rfind("pg:", 0) == 0;
 }
 
