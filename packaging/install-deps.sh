@@ -35,6 +35,9 @@ packages=(
   # MPI (issue 15, GROUNDPLAN_MPI=AUTO|ON|OFF): `mpirun -np N groundplan ...` spreads the tiled run over
   # ranks, tests/e2e/test_mpi.py runs it; Open MPI is the MPI CMake's AUTO looks for
   openmpi-bin libopenmpi-dev
+  # a PostGIS server for the test of MPI ranks writing into one PostgreSQL database side by side (issue 15
+  # stage 5, tests/e2e/test_postgis.py starts it on a temporary folder, local socket only; psql comes with postgresql)
+  postgresql postgresql-15-postgis-3
   # fuzzing (libFuzzer with clang; tests/fuzz) and the sanitizer runtime's symbolizer
   clang libclang-rt-14-dev llvm
 )

@@ -9,6 +9,7 @@
 #include "preview.h"
 #ifdef GROUNDPLAN_WITH_MPI
 #include "mpi_exchange.h"
+#include "rank_writes.h"
 #include "staged_output.h"
 #endif
 
@@ -470,6 +471,121 @@ std::string tiles_ruled_out(const PipelineOptions& options, const Ogr2ogrArgs& o
   return {};
 }
 
+/// --stats of a tiled run (one process or ranks): counts, timings, "tiles", "mpi". `plans`: in the whole dataset
+/// (rank 0 of a run whose ranks write their own plans holds none of theirs). False (said) when it cannot be written.
+bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::TiledResult& r, std::size_t plans,
+                       double write_s, double index_s, const WriteOutcome* written, double total_s,
+                       double cpu_s) {
+  if (stats_path.empty()) return true;
+  const groundplan::gis::TileStats& t = r.tiles;
+  nlohmann::json j;
+  j["counts"] = {{"buildings", r.buildings_read}, {"footprints", r.footprints}, {"dropped", r.buildings_dropped},
+                 {"blocks", r.blocks}, {"ground_plans", plans}, {"problems", count_defects(r.problems)}};
+  j["timings_s"] = {{"read", r.timings.read_s}, {"footprints", r.timings.footprints_s}, {"blocks", r.timings.blocks_s},
+                    {"union", r.timings.union_s}, {"write", write_s}, {"spatial_index", index_s},
+                    {"total", total_s}, {"cpu", cpu_s}};
+  j["reading"] = {{"threads", r.reading.threads}, {"files", r.reading.files}, {"bytes", r.reading.bytes},
+                  {"files_chunked", r.reading.files_chunked}, {"chunks", r.reading.chunks}};
+  j["tiles"] = {{"tiles", t.tiles}, {"tile_plans", t.tile_plans}, {"final_at_once", t.final_plans},
+                {"seam_plans", t.seam_plans}, {"seam_footprints", t.seam_footprints},
+                {"plans_from_seams", t.reduced_plans}, {"max_tile_footprints", t.max_tile_footprints},
+                {"tiles_in_flight", t.tiles_in_flight}, {"spill_bytes", t.spill_bytes},
+                {"map_s", t.map_s}, {"reduce_s", t.reduce_s}};
+  if (r.ranks.size() > 1) {  // the run over MPI ranks: each rank's share
+    nlohmann::json per_rank = nlohmann::json::array();
+    for (const groundplan::gis::RankStats& s : r.ranks)
+      per_rank.push_back({{"tiles", s.tiles}, {"bytes", s.bytes}, {"footprints", s.footprints},
+                          {"seam_footprints_united", s.seam_footprints}, {"map_s", s.map_s},
+                          {"reduce_s", s.reduce_s}, {"gather_s", s.gather_s}, {"cpu_s", s.cpu_s},
+                          {"peak_rss_bytes", s.peak_rss_bytes}});
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    j["mpi"] = {{"ranks", r.ranks.size()}, {"reduce_rounds", t.reduce_rounds}, {"per_rank", per_rank},
+                {"rank0_peak_rss_after_write_bytes", static_cast<std::uint64_t>(u.ru_maxrss) * 1024}};
+  }
+  j["raster_backend"] = r.raster_backend;
+  if (written && written->own_index && written->ok) j["spatial_index"] = spatial_index_json(written->built);
+  if (written && !written->writer.is_null()) j["writer"] = written->writer;
+  std::ofstream f(stats_path);
+  f << j.dump(2) << '\n';
+  if (!f) std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());
+  return static_cast<bool>(f);
+}
+
+/// What a tiled run says when it has written (unless -q): counts, the tiles' share, timings, problems.
+void print_tiled_summary(const groundplan::gis::TiledResult& r, const Ogr2ogrArgs& ogr, const std::string& dst,
+                         std::size_t plans, double total_s, double write_s) {
+  const groundplan::gis::TileStats& t = r.tiles;
+  std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles%s\n", r.buildings_read, ogr.src.c_str(),
+              r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles,
+              r.ranks.size() > 1 ? (" on " + std::to_string(r.ranks.size()) + " MPI ranks").c_str() : "");
+  std::printf("groundplan: %zu footprints -> %zu ground plans (%zu final at once, %zu from %zu seam plans of "
+              "%zu footprints); %zu problems\n",
+              r.footprints, plans, t.final_plans, t.reduced_plans, t.seam_plans, t.seam_footprints,
+              count_defects(r.problems));
+  std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", dst.c_str(), total_s,
+              t.map_s, t.reduce_s, write_s);
+  print_problems(r.problems);
+}
+
+#ifdef GROUNDPLAN_WITH_MPI
+/// A tiled result without plans or problems, in `like`'s CRS: the layers rank 0 makes the tables from.
+class NoPlans final : public groundplan::gis::TiledResult {
+ public:
+  explicit NoPlans(const groundplan::gis::TiledResult& like) {
+    crs_wkt = like.crs_wkt;
+    crs_name = like.crs_name;
+  }
+  std::size_t plan_count() const override { return 0; }
+  groundplan::gis::StoredPlan plan(std::size_t) const override { throw std::out_of_range("NoPlans has no plan"); }
+  std::uint64_t members_before(std::size_t) const override { return 0; }
+};
+
+/// The tiled run over ranks into PostgreSQL (issue 15 stage 5, rank_writes.h): every rank writes its own final
+/// plans into the tables rank 0 makes, each in a transaction committed once all have written.
+int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std::string& stats_path,
+                            const groundplan::Progress& progress, Ranks& ranks) {
+  const double cpu0 = groundplan::gis::process_cpu_seconds();
+  const auto t0 = clock::now();
+  const bool root = ranks.rank() == 0;
+  std::shared_ptr<const groundplan::gis::TiledResult> result = groundplan::gis::run_pipeline_tiled(
+      options, ranks, root ? progress : groundplan::Progress{}, groundplan::gis::FinalPlans::kept_by_each_rank);
+  const groundplan::gis::TiledResult& r = *result;
+  const std::size_t plans = r.tiles.final_plans + r.tiles.reduced_plans;  // rank 0: over all ranks
+  groundplan::cli::TableSetup setup;
+  setup.dst = ogr.dst;
+  setup.options = ogr.options;
+  if (!ogr.layer_named) setup.options.push_back("ground_plans");
+  if (root && r.footprints == 0) {
+    if (!ogr.quiet) print_problems(r.problems);
+    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
+                 r.buildings_read == 0
+                     ? "no building found"
+                     : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+    setup.create = false;
+  }
+  auto* mine = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
+                                                               result, 0, options.threads);
+  auto* empty = new groundplan::driver::OGRGroundPlanDataSource(
+      std::string(groundplan::driver::kPrefix) + ogr.src, std::make_shared<const NoPlans>(r), 0, options.threads);
+  const groundplan::cli::RankWrite w = groundplan::cli::write_from_every_rank(
+      ranks, setup, mine, empty, [&ranks] { ranks.test_point("commit"); });
+  if (!root) return w.ok ? 0 : 1;
+  if (!setup.create) {
+    write_tiled_stats(stats_path, r, 0, 0, 0, nullptr, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0);
+    return 1;
+  }
+  if (!w.ok) {
+    std::fprintf(stderr, "groundplan: could not write %s: %s\n", ogr.dst.c_str(), w.why.c_str());
+    return 1;
+  }
+  const int rc = write_tiled_stats(stats_path, r, plans, w.write_s, 0, nullptr, seconds_since(t0),
+                                   groundplan::gis::process_cpu_seconds() - cpu0) ? 0 : 1;
+  if (!ogr.quiet) print_tiled_summary(r, ogr, ogr.dst + " (every rank its own plans)", plans, seconds_since(t0), w.write_s);
+  return rc;
+}
+#endif
+
 /// The tiled run (issue 15, gis/tiled.h): same plans with bounded memory; the final plans of all tiles first,
 /// then the plans from seams. --stats says how many were final at once and how many were seams.
 int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const std::string& stats_path,
@@ -482,6 +598,9 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   // Over ranks (issue 15): rank 0 gets every plan and writes the one dataset, into a staging folder that is moved
   // into place once every rank has finished (staged_output.h); the others only map and reduce.
   std::unique_ptr<groundplan::cli::StagedOutput> staged;
+  // A database: every rank writes its own plans (stage 5); files: rank 0 writes them all.
+  if (rank_count(ranks) > 1 && groundplan::cli::written_by_every_rank(ogr.format, ogr.dst))
+    return run_tiled_into_database(options, ogr, stats_path, progress, *ranks);
   if (rank_count(ranks) > 1) {
     result = groundplan::gis::run_pipeline_tiled(options, *ranks, ranks->rank() == 0 ? progress : groundplan::Progress{});
     if (ranks->rank() != 0) {
@@ -505,40 +624,8 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   if (!result) result = groundplan::gis::run_pipeline_tiled(options, progress);
   const groundplan::gis::TiledResult& r = *result;
   auto stats = [&](double write_s, double index_s, const WriteOutcome* written) {
-    if (stats_path.empty()) return true;
-    const groundplan::gis::TileStats& t = r.tiles;
-    nlohmann::json j;
-    j["counts"] = {{"buildings", r.buildings_read}, {"footprints", r.footprints}, {"dropped", r.buildings_dropped},
-                   {"blocks", r.blocks}, {"ground_plans", r.plan_count()}, {"problems", count_defects(r.problems)}};
-    j["timings_s"] = {{"read", r.timings.read_s}, {"footprints", r.timings.footprints_s}, {"blocks", r.timings.blocks_s},
-                      {"union", r.timings.union_s}, {"write", write_s}, {"spatial_index", index_s},
-                      {"total", seconds_since(t0)}, {"cpu", groundplan::gis::process_cpu_seconds() - cpu0}};
-    j["reading"] = {{"threads", r.reading.threads}, {"files", r.reading.files}, {"bytes", r.reading.bytes},
-                    {"files_chunked", r.reading.files_chunked}, {"chunks", r.reading.chunks}};
-    j["tiles"] = {{"tiles", t.tiles}, {"tile_plans", t.tile_plans}, {"final_at_once", t.final_plans},
-                  {"seam_plans", t.seam_plans}, {"seam_footprints", t.seam_footprints},
-                  {"plans_from_seams", t.reduced_plans}, {"max_tile_footprints", t.max_tile_footprints},
-                  {"tiles_in_flight", t.tiles_in_flight}, {"spill_bytes", t.spill_bytes},
-                  {"map_s", t.map_s}, {"reduce_s", t.reduce_s}};
-    if (r.ranks.size() > 1) {  // the run over MPI ranks: each rank's share
-      nlohmann::json per_rank = nlohmann::json::array();
-      for (const groundplan::gis::RankStats& s : r.ranks)
-        per_rank.push_back({{"tiles", s.tiles}, {"bytes", s.bytes}, {"footprints", s.footprints},
-                            {"seam_footprints_united", s.seam_footprints}, {"map_s", s.map_s},
-                            {"reduce_s", s.reduce_s}, {"gather_s", s.gather_s}, {"cpu_s", s.cpu_s},
-                            {"peak_rss_bytes", s.peak_rss_bytes}});
-      rusage u{};
-      getrusage(RUSAGE_SELF, &u);
-      j["mpi"] = {{"ranks", r.ranks.size()}, {"reduce_rounds", t.reduce_rounds}, {"per_rank", per_rank},
-                  {"rank0_peak_rss_after_write_bytes", static_cast<std::uint64_t>(u.ru_maxrss) * 1024}};
-    }
-    j["raster_backend"] = r.raster_backend;
-    if (written && written->own_index && written->ok) j["spatial_index"] = spatial_index_json(written->built);
-    if (written && !written->writer.is_null()) j["writer"] = written->writer;
-    std::ofstream f(stats_path);
-    f << j.dump(2) << '\n';
-    if (!f) std::fprintf(stderr, "groundplan: cannot write stats file %s\n", stats_path.c_str());
-    return static_cast<bool>(f);
+    return write_tiled_stats(stats_path, r, r.plan_count(), write_s, index_s, written, seconds_since(t0),
+                             groundplan::gis::process_cpu_seconds() - cpu0);
   };
   if (r.footprints == 0) {
     if (!ogr.quiet) print_problems(r.problems);
@@ -564,19 +651,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   if (!w.members_note.empty()) std::fprintf(stderr, "groundplan: note: %s\n", w.members_note.c_str());
   // Over ranks the dataset is in place only now: "wrote" is said after that.
   const int rc = finish(stats(w.write_s, w.index_s, &w) ? 0 : 1);
-  if (!ogr.quiet) {
-    const groundplan::gis::TileStats& t = r.tiles;
-    std::printf("groundplan: read %zu buildings from %s (CRS %s) in %zu tiles%s\n", r.buildings_read, ogr.src.c_str(),
-                r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles,
-                r.ranks.size() > 1 ? (" on " + std::to_string(r.ranks.size()) + " MPI ranks").c_str() : "");
-    std::printf("groundplan: %zu footprints -> %zu ground plans (%zu final at once, %zu from %zu seam plans of "
-                "%zu footprints); %zu problems\n",
-                r.footprints, r.plan_count(), t.final_plans, t.reduced_plans, t.seam_plans, t.seam_footprints,
-                count_defects(r.problems));
-    std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", ogr_in.dst.c_str(),
-                seconds_since(t0), t.map_s, t.reduce_s, w.write_s);
-    print_problems(r.problems);
-  }
+  if (!ogr.quiet) print_tiled_summary(r, ogr, ogr_in.dst, r.plan_count(), seconds_since(t0), w.write_s);
   return rc;
 }
 

@@ -52,7 +52,7 @@ MpiExchange::MpiExchange(int* argc, char*** argv) {
 MpiExchange::~MpiExchange() { MPI_Finalize(); }
 
 void MpiExchange::barrier() {
-  test_failure(true);
+  test_failure("end");
   check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
 }
 
@@ -64,25 +64,29 @@ void MpiExchange::abort(const std::string& why, int code) {
   std::_Exit(code);
 }
 
-// A test hook (tests/e2e/test_mpi.py): GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW makes rank RANK fail at its second
-// allgather (after the map), or with HOW ending in "@end" at the final barrier (rank 0 has written then):
+// A test hook (tests/e2e/test_mpi.py, test_postgis.py): GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW makes rank RANK fail at
+// its second allgather (after the map), with HOW ending in "@end" at the final barrier (rank 0 has written then),
+// with "@commit" where a rank writing into a database has written its rows but not committed them (test_point):
 // HOW = throw (an exception, as a failing rank) or kill (SIGKILL, as a dead one).
-void MpiExchange::test_failure(bool at_end) {
-  if (!at_end && ++calls_ != 2) return;
+void MpiExchange::test_failure(const std::string& point) {
+  if (point.empty() && ++calls_ != 2) return;
   const char* v = std::getenv("GROUNDPLAN_MPI_TEST_FAIL");
   if (!v) return;
   std::string s(v);
-  const bool end = s.size() > 4 && s.compare(s.size() - 4, 4, "@end") == 0;
-  if (end != at_end) return;
-  if (end) s.resize(s.size() - 4);
+  const std::size_t at = s.find('@');
+  const std::string where = at == std::string::npos ? std::string() : s.substr(at + 1);
+  if (where != point) return;
+  s.resize(std::min(s.size(), at));
   const std::size_t colon = s.find(':');
   if (colon == std::string::npos || std::atoi(s.substr(0, colon).c_str()) != rank_) return;
   if (s.substr(colon + 1) == "kill") ::raise(SIGKILL);
   throw Error("GROUNDPLAN_MPI_TEST_FAIL: rank " + std::to_string(rank_) + " fails on purpose");
 }
 
+void MpiExchange::test_point(const std::string& point) { test_failure(point); }
+
 std::vector<char> MpiExchange::allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes) {
-  test_failure(false);
+  test_failure("");
   if (mine.size() > static_cast<std::size_t>(1) << 30) throw Error("MPI allgather: a part over 1 GiB");
   int n = static_cast<int>(mine.size());
   std::vector<int> counts(static_cast<std::size_t>(size_));

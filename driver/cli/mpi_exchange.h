@@ -25,11 +25,13 @@ class MpiExchange final : public gis::TileExchange {
   void barrier();
   /// Ends every rank of the job at once (MPI_Abort), after saying why on stderr. Does not return.
   [[noreturn]] void abort(const std::string& why, int code = 1);
+  /// A named point where GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW@POINT makes this rank fail (tests only; see the .cpp).
+  void test_point(const std::string& point);
 
  private:
   int rank_ = 0, size_ = 1;
   int calls_ = 0;  // for GROUNDPLAN_MPI_TEST_FAIL
-  void test_failure(bool at_end);
+  void test_failure(const std::string& point);
 };
 
 /// True when this process was started by Open MPI's mpirun (its environment says so).

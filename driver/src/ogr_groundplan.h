@@ -24,7 +24,8 @@ namespace groundplan::driver {
 /// as OGR users expect.
 class OGRGroundPlanLayer final : public OGRLayer {
  public:
-  /// Makes the feature of index i (FID i + 1) with `defn`; called from several threads at once.
+  /// Makes the feature of index i with `defn` (FID i + 1 unless the maker sets one: a rank writing its share of
+  /// a dataset numbers its features as the whole dataset does); called from several threads at once.
   using Maker = std::function<OGRFeature*(OGRFeatureDefn* defn, std::size_t i)>;
   using Extent = std::function<OGREnvelope()>;
   /// `threads`: cores that build batches (0 = all).

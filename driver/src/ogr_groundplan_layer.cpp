@@ -47,7 +47,7 @@ void OGRGroundPlanLayer::build(Batch& batch, std::size_t first) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       batch[i].reset(make_(defn_, first + i));
-      batch[i]->SetFID(static_cast<GIntBig>(first + i) + 1);
+      if (batch[i]->GetFID() == OGRNullFID) batch[i]->SetFID(static_cast<GIntBig>(first + i) + 1);
     }
   });
 }

@@ -39,7 +39,9 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
           ids += id;
         }
         if (max_id_list_chars && ids.size() > max_id_list_chars) (*cut)[i] = 1;
-        f->SetField(0, static_cast<GIntBig>(i + 1));
+        const auto gp_id = static_cast<GIntBig>(res->plan_number(i) + 1);
+        f->SetFID(gp_id);
+        f->SetField(0, gp_id);
         f->SetField(1, static_cast<int>(sp.plan.members.size()));
         f->SetField(2, sp.plan.area_m2);
         if (!sp.member_ids.empty()) {
@@ -82,7 +84,8 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
         const gis::StoredPlan sp = res->plan(lo);
         const std::size_t k = r - static_cast<std::size_t>(res->members_before(lo));
         auto* f = new OGRFeature(defn);
-        f->SetField(0, static_cast<GIntBig>(lo) + 1);
+        f->SetFID(static_cast<GIntBig>(res->row_number(lo) + k) + 1);
+        f->SetField(0, static_cast<GIntBig>(res->plan_number(lo)) + 1);
         f->SetField(1, static_cast<GIntBig>(sp.plan.members[k]) + 1);
         f->SetField(2, sp.member_ids[k].c_str());
         return f;

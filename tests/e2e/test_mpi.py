@@ -170,3 +170,79 @@ def test_one_rank_without_mpirun_is_the_plain_cli(tmp_path, city, city_one):
     got = outputs(tmp_path, "plain", folder, "--tiles", "on", "--id-field", "bid")
     assert got[0] == city_one[0]
     assert "mpi" not in got[3]
+
+
+# NRW-like tiles (issue 15 stage 3): North Rhine-Westphalia publishes LoD2 CityGML in 1 km tiles named
+# LoD2_32_<km east>_<km north>_1_NW.gml (EPSG:25832 with DHHN2016 heights). Generated here: 3 x 3 tiles, courtyard
+# blocks (60 m, the yard a hole) on a 500 m pitch, those at x or y = 970 and 1970 crossing the 1 km edges (one at
+# each inner tile corner, in four tiles), and two rows of 12 touching houses across the edges x = 1000 and 2000;
+# every building a LoD2 box (ground, roof, walls) in the tile of its centre.
+NRW_EAST, NRW_NORTH = 350000, 5660000
+NRW_BLOCKS = 25
+NRW_ROW = 12
+
+
+def lod2_box(bid, x0, y0, x1, y1, height):
+    def ring(pts):
+        pts = pts + [pts[0]]
+        return ("<gml:Polygon><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">"
+                + " ".join(f"{x:.3f} {y:.3f} {z:.3f}" for x, y, z in pts)
+                + "</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon>")
+
+    x0, y0, x1, y1 = NRW_EAST + x0, NRW_NORTH + y0, NRW_EAST + x1, NRW_NORTH + y1
+    z0, z1 = 60.0, 60.0 + height
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    surfaces = [("GroundSurface", ring([(x, y, z0) for x, y in reversed(corners)])),
+                ("RoofSurface", ring([(x, y, z1) for x, y in corners]))]
+    for (xa, ya), (xb, yb) in zip(corners, corners[1:] + corners[:1]):
+        surfaces.append(("WallSurface", ring([(xa, ya, z0), (xb, yb, z0), (xb, yb, z1), (xa, ya, z1)])))
+    bounded = "".join(f"<bldg:boundedBy><bldg:{kind}><bldg:lod2MultiSurface><gml:MultiSurface><gml:surfaceMember>"
+                      f"{poly}</gml:surfaceMember></gml:MultiSurface></bldg:lod2MultiSurface></bldg:{kind}>"
+                      "</bldg:boundedBy>" for kind, poly in surfaces)
+    return (f"<core:cityObjectMember><bldg:Building gml:id=\"{bid}\"><bldg:measuredHeight uom=\"urn:adv:uom:m\">"
+            f"{height}</bldg:measuredHeight>{bounded}</bldg:Building></core:cityObjectMember>\n")
+
+
+def nrw_like_tiles(folder):
+    buildings = []
+    for i in range(1, 6):
+        for j in range(1, 6):
+            x0, y0 = 500 * i - 30, 500 * j - 30
+            buildings += [(x0, y0, x0 + 60, y0 + 16), (x0, y0 + 44, x0 + 60, y0 + 60),
+                          (x0, y0 + 16, x0 + 16, y0 + 44), (x0 + 44, y0 + 16, x0 + 60, y0 + 44)]
+    for start in (880, 1880):
+        buildings += [(start + 20 * k, 1700, start + 20 * k + 20, 1712) for k in range(NRW_ROW)]
+    tiles = {}
+    for n, (x0, y0, x1, y1) in enumerate(buildings):
+        key = (int((x0 + x1) / 2 // 1000), int((y0 + y1) / 2 // 1000))
+        tiles.setdefault(key, []).append(lod2_box(f"DENW{n:012d}", x0, y0, x1, y1, 8 + n % 7))
+    folder.mkdir()
+    head = ('<?xml version="1.0" encoding="UTF-8"?>\n<core:CityModel xmlns:core="http://www.opengis.net/citygml/2.0" '
+            'xmlns:bldg="http://www.opengis.net/citygml/building/2.0" xmlns:gml="http://www.opengis.net/gml">\n'
+            '<gml:boundedBy><gml:Envelope srsName="urn:adv:crs:ETRS89_UTM32*DE_DHHN2016_NH" srsDimension="3">'
+            '<gml:lowerCorner>{} {} 0</gml:lowerCorner><gml:upperCorner>{} {} 100</gml:upperCorner>'
+            '</gml:Envelope></gml:boundedBy>\n')
+    for (tx, ty), members in sorted(tiles.items()):
+        e, n = NRW_EAST // 1000 + tx, NRW_NORTH // 1000 + ty
+        (folder / f"LoD2_32_{e}_{n}_1_NW.gml").write_text(
+            head.format(e * 1000, n * 1000, e * 1000 + 1000, n * 1000 + 1000) + "".join(members) + "</core:CityModel>\n")
+    return len(tiles), len(buildings)
+
+
+def test_nrw_like_tiles_over_4_ranks(tmp_path):
+    """Stage 3: the NRW-like folder over 4 ranks gives the one-process plans."""
+    folder = tmp_path / "nrw"
+    tiles, buildings = nrw_like_tiles(folder)
+    assert tiles == 9
+    one = outputs(tmp_path, "one", folder, "--tiles", "off")
+    got = outputs(tmp_path, "mpi", folder, "--tiles", "on", launcher=mpirun(4))
+    assert got[0] == one[0], "plans differ from the one-process run"
+    assert got[1] == one[1], "plan members differ"
+    assert got[2] == one[2], "problems differ"
+    # the generator's own count: a plan a block (its yard a hole) and one a row; every building a footprint
+    assert len(got[0]) == NRW_BLOCKS + 2
+    assert sum(1 for p in got[0] if len(p[0][1]) == 1) == NRW_BLOCKS
+    assert sorted(int(p[1]) for p in got[0])[-2:] == [NRW_ROW, NRW_ROW]
+    assert got[3]["counts"]["footprints"] == buildings
+    assert got[3]["tiles"]["seam_plans"] > 0
+    check_plans(got, got[3], 4, tiles)

@@ -39,6 +39,8 @@ class SpilledResult final : public TiledResult {
     detail::SpilledPlan s = spill.read(finals.at(i), false);
     StoredPlan out;
     out.plan = std::move(s.plan);
+    if (!segments.empty())
+      for (std::uint32_t& m : out.plan.members) m += segment(i).id_shift;
     out.member_ids.reserve(s.footprints.size());
     for (std::size_t k = 0; k < s.footprints.size(); ++k) {
       const Footprint& fp = s.footprints[k];
@@ -50,6 +52,31 @@ class SpilledResult final : public TiledResult {
   }
 
   std::uint64_t members_before(std::size_t i) const override { return rows_before.at(i); }
+  std::uint64_t plan_number(std::size_t i) const override {
+    if (segments.empty()) return i;
+    const Segment& g = segment(i);
+    return g.plan + (i - g.first);
+  }
+  std::uint64_t row_number(std::size_t i) const override {
+    if (segments.empty()) return rows_before.at(i);
+    const Segment& g = segment(i);
+    return g.row + (rows_before.at(i) - rows_before.at(g.first));
+  }
+
+  /// A rank that keeps its final plans (FinalPlans::kept_by_each_rank): its plans from `first` on are numbered
+  /// from `plan` in the one dataset, their members from row `row`, member ids shifted by `id_shift` to global
+  /// ones (the map's plans hold the rank's own footprint numbers). Ascending `first`; empty: numbered as stored.
+  struct Segment {
+    std::size_t first = 0;
+    std::uint64_t plan = 0, row = 0;
+    std::uint32_t id_shift = 0;
+  };
+  std::vector<Segment> segments;
+  const Segment& segment(std::size_t i) const {
+    auto it = std::upper_bound(segments.begin(), segments.end(), i,
+                               [](std::size_t v, const Segment& g) { return v < g.first; });
+    return *(it - 1);
+  }
 
   detail::PlanSpill spill;
   std::vector<std::uint64_t> rows_before{0};  // plan_members rows before each plan, and all of them last
@@ -227,8 +254,42 @@ void receive_finals(int from, SpilledResult& out, TileExchange& ex) {
   }
 }
 
+/// FinalPlans::kept_by_each_rank: where this rank's final plans stand in the order rank 0 would have gathered
+/// them (every rank's map plans in rank order, then every rank's reduce plans), from one allgather of the counts.
+void number_kept_plans(const Finals& map_finals, const Finals& reduce_finals, std::uint32_t id_offset,
+                       SpilledResult& out, TileExchange& ex) {
+  auto rows = [](const Finals& f) { return std::accumulate(f.members.begin(), f.members.end(), std::uint64_t{0}); };
+  detail::Packer p;
+  for (std::uint64_t v : {std::uint64_t(map_finals.offsets.size()), rows(map_finals),
+                          std::uint64_t(reduce_finals.offsets.size()), rows(reduce_finals)})
+    p.put(v);
+  const std::vector<char> all = ex.allgather(p.bytes);
+  if (all.size() != p.bytes.size() * static_cast<std::size_t>(ex.size()))
+    throw Error("tiled run over ranks: plan counts of the wrong size");
+  std::uint64_t map_plans = 0, map_rows = 0, reduce_plans = 0, reduce_rows = 0;  // before this rank
+  std::uint64_t all_map_plans = 0, all_map_rows = 0;
+  detail::Unpacker u(all.data(), all.size());
+  for (int r = 0; r < ex.size(); ++r) {
+    const std::uint64_t mp = u.get<std::uint64_t>(), mr = u.get<std::uint64_t>();
+    const std::uint64_t rp = u.get<std::uint64_t>(), rr = u.get<std::uint64_t>();
+    if (r < ex.rank()) {
+      map_plans += mp;
+      map_rows += mr;
+      reduce_plans += rp;
+      reduce_rows += rr;
+    }
+    all_map_plans += mp;
+    all_map_rows += mr;
+  }
+  for (std::size_t i = 0; i < map_finals.offsets.size(); ++i) out.add_final(map_finals.offsets[i], map_finals.members[i]);
+  for (std::size_t i = 0; i < reduce_finals.offsets.size(); ++i)
+    out.add_final(reduce_finals.offsets[i], reduce_finals.members[i]);
+  out.segments = {{0, map_plans, map_rows, id_offset},
+                  {map_finals.offsets.size(), all_map_plans + reduce_plans, all_map_rows + reduce_rows, 0}};
+}
+
 std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Progress& progress, std::size_t threads,
-                                       TileExchange& ex) {
+                                       TileExchange& ex, FinalPlans final_plans) {
   const double cpu0 = process_cpu_seconds();
   const int me = ex.rank(), ranks = ex.size();
   auto out = std::make_unique<SpilledResult>();
@@ -462,7 +523,10 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
   // Rank 0 gathers: every rank's final plans of the map (rank order = tile order), then those of the reduce,
   // streamed; then counts and problems. The other ranks keep nothing.
   const auto t_gather = clock_type::now();
-  if (me == 0) {
+  const bool kept = final_plans == FinalPlans::kept_by_each_rank && ranks > 1;
+  if (kept) {
+    number_kept_plans(map_finals, reduce_finals, my_offset, *out, ex);
+  } else if (me == 0) {
     for (std::size_t i = 0; i < map_finals.offsets.size(); ++i) out->add_final(map_finals.offsets[i], map_finals.members[i]);
     for (int r = 1; r < ranks; ++r) receive_finals(r, *out, ex);
     for (std::size_t i = 0; i < reduce_finals.offsets.size(); ++i)
@@ -483,7 +547,11 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     pack_part(part, p);
     if (me != 0) {
       ex.send(0, p.bytes);
-      return std::make_unique<SpilledResult>();
+      if (!kept) return std::make_unique<SpilledResult>();
+      out->crs_wkt = acc.crs_wkt;  // its plans only: counts and problems are rank 0's
+      out->crs_name = acc.crs_name;
+      std::copy(all.begin(), all.end(), out->extent);
+      return out;
     }
     PipelineResult sum;
     sum.crs_wkt = acc.crs_wkt;
@@ -561,7 +629,7 @@ std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, 
 }
 
 std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, TileExchange& exchange,
-                                                const Progress& progress) {
+                                                const Progress& progress, FinalPlans final_plans) {
   if (options.threads < 0) throw InvalidArgument("threads: " + std::to_string(options.threads) + " is not >= 1 (0 = all cores)");
   if (options.detail.any())
     throw InvalidArgument("tiles: a level of detail (--snap, --close-gaps, --simplify, --min-area, --preset ...) "
@@ -569,7 +637,7 @@ std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, 
   const std::size_t threads = thread_count(options.threads);
   tbb::task_arena arena(static_cast<int>(threads));
   std::unique_ptr<TiledResult> result;
-  arena.execute([&] { result = run_tiled(options, progress, threads, exchange); });
+  arena.execute([&] { result = run_tiled(options, progress, threads, exchange, final_plans); });
   return result;
 }
 

@@ -278,5 +278,65 @@ TEST(TiledRunOverRanks, ThreadsAsRanksGiveTheOneProcessPlans) {
   }
 }
 
+/// Runs `options` over n ranks played by threads; every rank's result, in rank order.
+std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOptions& options, int n, FinalPlans where) {
+  ThreadRanks all(n);
+  std::vector<std::unique_ptr<TiledResult>> results(static_cast<std::size_t>(n));
+  std::vector<std::string> errors(static_cast<std::size_t>(n));
+  std::vector<std::thread> threads;
+  for (int r = 0; r < n; ++r)
+    threads.emplace_back([&, r] {
+      ThreadRanks::Rank me(all, r);
+      try {
+        results[static_cast<std::size_t>(r)] = run_pipeline_tiled(options, me, {}, where);
+      } catch (const std::exception& e) {
+        errors[static_cast<std::size_t>(r)] = e.what();
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  for (int r = 0; r < n; ++r) EXPECT_EQ(errors[static_cast<std::size_t>(r)], "") << n << " ranks, rank " << r;
+  return results;
+}
+
+// Stage 5 (every rank writes its own plans into a database): each rank keeps its final plans, and
+// plan_number/row_number put each where rank 0 has it when the plans are gathered, with the same global members;
+// together the ranks hold every plan once.
+TEST(TiledRunOverRanks, KeptPlansAreNumberedAsRankZeroGathersThem) {
+  GDALAllRegister();
+  const test::TempDir dir("groundplan_tile_ranks_kept");
+  PipelineOptions options;
+  options.inputs = {city(dir)};
+  options.ogr_input.id_field = "bid";
+  options.threads = 1;
+  for (int n : {2, 3, 5}) {
+    const auto gathered = over_thread_ranks(options, n, FinalPlans::to_rank_0);
+    const auto kept = over_thread_ranks(options, n, FinalPlans::kept_by_each_rank);
+    ASSERT_TRUE(gathered[0] && kept[0]);
+    const TiledResult& g = *gathered[0];
+    ASSERT_EQ(g.plan_count(), 37u);
+    std::vector<int> seen(g.plan_count(), 0);
+    std::size_t on_other_ranks = 0;
+    for (int r = 0; r < n; ++r) {
+      const TiledResult& k = *kept[static_cast<std::size_t>(r)];
+      if (r > 0) on_other_ranks += k.plan_count();
+      for (std::size_t i = 0; i < k.plan_count(); ++i) {
+        const std::uint64_t at = k.plan_number(i);
+        ASSERT_LT(at, g.plan_count()) << n << " ranks, rank " << r;
+        ++seen[at];
+        const StoredPlan a = k.plan(i), b = g.plan(static_cast<std::size_t>(at));
+        EXPECT_EQ(a.plan.members, b.plan.members) << n << " ranks, rank " << r << " plan " << i;
+        EXPECT_EQ(a.member_ids, b.member_ids);
+        EXPECT_EQ(a.plan.polygon.outer, b.plan.polygon.outer);
+        EXPECT_EQ(k.row_number(i), g.members_before(static_cast<std::size_t>(at)));
+      }
+    }
+    EXPECT_EQ(seen, std::vector<int>(g.plan_count(), 1)) << n << " ranks: every plan once";
+    EXPECT_GT(on_other_ranks, 0u);  // not all on rank 0: the others write theirs
+    // rank 0 still has the counts of all ranks
+    EXPECT_EQ(kept[0]->tiles.final_plans + kept[0]->tiles.reduced_plans, g.plan_count());
+    EXPECT_EQ(kept[0]->footprints, g.footprints);
+  }
+}
+
 }  // namespace
 }  // namespace groundplan::gis::detail

@@ -87,6 +87,13 @@ class TiledResult {
   virtual StoredPlan plan(std::size_t i) const = 0;
   /// Rows of plan_members before plan i (the members of plans 0..i-1); i = plan_count() gives all rows.
   virtual std::uint64_t members_before(std::size_t i) const = 0;
+  /// The number (0-based) plan i has in the one dataset: i, except where every rank writes its own plans
+  /// (FinalPlans::kept_by_each_rank): then the index it would have in rank 0's gathered order, so that gp_id and
+  /// feature ids are those of a run that gathers (the map's final plans rank by rank, then the reduce's).
+  virtual std::uint64_t plan_number(std::size_t i) const { return i; }
+  /// The plan_members row (0-based) of plan i's first member in the one dataset (members_before(i) where
+  /// plan_number(i) is i).
+  virtual std::uint64_t row_number(std::size_t i) const { return members_before(i); }
 
   std::vector<Problem> problems;
   std::size_t footprints = 0;  // footprints made (all tiles), as PipelineResult::footprints.size()
@@ -112,12 +119,22 @@ std::uint64_t estimated_footprint_bytes(const std::vector<std::string>& inputs, 
 /// (InvalidArgument): closing gaps and simplifying look past a plan's own box. Throws as run_pipeline.
 std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, const Progress& progress = {});
 
+/// Where the final plans of a run over ranks end up.
+enum class FinalPlans {
+  to_rank_0,          // streamed to rank 0, which writes the one dataset (files)
+  kept_by_each_rank,  // each rank keeps its own, numbered as rank 0 would have them, and writes them (a database)
+};
+
 /// The same run spread over the ranks of `exchange` (issue 15 stage 2): rank r maps a contiguous run of the
 /// input files (balanced by bytes), the tiles' extents are exchanged, each rank classifies its plans as the
 /// one-process tiled run does, the seams are reduced by a tree (rank pairs, ceil(log2 N) rounds) with the same
 /// engine, and every final plan is streamed to rank 0. Rank 0's result holds all plans, problems and counts;
-/// the other ranks' results hold none (plan_count() 0). Collective: every rank calls it.
+/// the other ranks' results hold none (plan_count() 0). With FinalPlans::kept_by_each_rank (stage 5) nothing is
+/// streamed: every rank's result holds its own final plans (plan_number/row_number give their place in the one
+/// dataset, member ids are global), rank 0's also the problems and the counts of all ranks. Collective: every
+/// rank calls it.
 std::unique_ptr<TiledResult> run_pipeline_tiled(const PipelineOptions& options, TileExchange& exchange,
-                                                const Progress& progress = {});
+                                                const Progress& progress = {},
+                                                FinalPlans final_plans = FinalPlans::to_rank_0);
 
 }  // namespace groundplan::gis

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+#pragma once
+// `mpirun -np N groundplan ... -f PostgreSQL PG:...` (issue 15 stage 5): every rank writes its own final plans into
+// the one database, side by side, instead of streaming them to rank 0. Rank 0 creates the tables (the user's
+// ogr2ogr options: -lco, -overwrite, -nln ...), every rank then appends its share in one transaction of its own, and
+// the transactions are committed only once every rank has written all of its rows (an allgather of their outcome):
+// a rank that dies before leaves every transaction open, and PostgreSQL rolls them back when mpirun ends the job.
+// docs/ARCHITECTURE.md ("Many machines") says what is left for a rank that dies inside the commits.
+#include <groundplan/gis/tiled.h>
+
+#include <gdal_priv.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace groundplan::cli {
+
+/// True for an output that every rank writes itself: OGR's PostgreSQL driver (-f PostgreSQL, or a PG: name
+/// without -f). Files keep rank 0 as their only writer.
+bool written_by_every_rank(const std::string& format, const std::string& dst);
+
+/// The user's ogr2ogr options for a rank's append into tables rank 0 has made: what only creating means (-f, -lco,
+/// -dsco, -overwrite) and the user's transaction settings (-gt, -ds_transaction, -lyr_transaction) are left out;
+/// -append, "-gt unlimited" (one transaction: the rank's own, see rank_writes.cpp) and -preserve_fid (feature ids as in the one
+/// dataset: ogc_fid = gp_id) are added; -preserve_fid not where -unsetFid or -explodecollections asks otherwise.
+std::vector<std::string> append_options(const std::vector<std::string>& options);
+
+/// What rank 0 needs to create the tables.
+struct TableSetup {
+  std::string dst;                   // the PG: datasource
+  std::vector<std::string> options;  // the user's ogr2ogr options and layer names, as for one process
+  bool create = true;                // false: rank 0 has nothing to write (says so itself); every rank stops
+};
+
+/// The outcome of a write by every rank.
+struct RankWrite {
+  bool ok = false;     // every rank wrote and committed
+  std::string why;     // otherwise: what failed, on which rank (rank 0 has the whole story)
+  double write_s = 0;  // this rank: creating (rank 0) + appending + committing
+};
+
+/// Collective over `ex`: rank 0 creates the tables from `empty_layers` (the layers of `mine` without features,
+/// in the working CRS), every rank appends the layers of `mine` (its share) in a transaction of its own and commits
+/// once every rank has written. Both datasets are taken (closed here). `before_commit` (a test hook) runs after
+/// this rank's rows are written, before the outcome is exchanged. A write that fails does not throw: every rank
+/// learns it and every transaction is rolled back; MPI failures throw.
+RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, GDALDataset* mine,
+                                GDALDataset* empty_layers, const std::function<void()>& before_commit);
+
+}  // namespace groundplan::cli
