@@ -151,7 +151,7 @@ struct Scratch {
   std::unique_ptr<char[]> bytes;
   std::size_t capacity = 0;
   dom::parser whole;
-  std::vector<Point3> vertices;
+  cityjson::VertexTable vertices;
   bool in_use = false;
 };
 constexpr std::size_t kKeepBytes = std::size_t{64} << 20;
@@ -176,7 +176,7 @@ class ScratchLease {
       s_->bytes.reset();
       s_->capacity = 0;
       s_->whole = dom::parser{};
-      std::vector<Point3>().swap(s_->vertices);
+      s_->vertices = cityjson::VertexTable{};
     }
   }
   Scratch& operator*() { return *s_; }
@@ -318,7 +318,7 @@ bool read_whole_dom(Scratch& scratch, std::size_t length, const std::string& pat
     }
     finish_top(top, path, problems, info);  // the checks; no raw vertices on this path
     // Straight into the thread's vector (its pages stay mapped from one file to the next).
-    std::vector<Point3>& vertices = scratch.vertices;
+    std::vector<Point3>& vertices = scratch.vertices.points;
     vertices.clear();
     std::size_t n = 0, bad = 0;
     for (dom::array a : vertex_arrays) n += a.size();
@@ -341,12 +341,13 @@ bool read_whole_dom(Scratch& scratch, std::size_t length, const std::string& pat
       }
     info.vertices = vertices.size();
     note_bad_vertices(bad, "\"vertices\"", path, problems);
+    scratch.vertices.classify(options.max_abs_coordinate);
     for (dom::key_value_pair field : root) {
       if (field.key != "CityObjects") continue;
       for (dom::key_value_pair object : field.value.get_object()) {
         ++at_object;
         object.value.get_object().value();  // as the On-Demand path: a city object that is no object ends the file
-        converter.convert(object.key, object.value, vertices, top.templates);
+        converter.convert(object.key, object.value, scratch.vertices, top.templates);
       }
     }
   } catch (const simdjson::simdjson_error& e) {
@@ -404,7 +405,9 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
         top.has_objects = true;  // second pass
       }
     }
-    const std::vector<Point3> vertices = finish_top(top, path, problems, info);
+    cityjson::VertexTable vertices;
+    vertices.points = finish_top(top, path, problems, info);
+    vertices.classify(options.max_abs_coordinate);
 
     // A second iteration rather than doc.rewind(): UBSan finds rewind() reading a null parser after some
     // malformed first passes (simdjson 3.0.1); the same parser keeps its buffers, only stage 1 runs again.
@@ -443,7 +446,7 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
   std::unique_ptr<dom::parser> header_parser = make_dom_parser(options.max_depth);  // keeps the templates alive
   std::unique_ptr<dom::parser> line_parser = make_dom_parser(options.max_depth);
   Templates templates;
-  std::vector<Point3> vertices;
+  cityjson::VertexTable vertices;
   ObjectConverter converter(path, options, on_mesh, problems, info);
   bool have_header = false;
 
@@ -505,8 +508,9 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
       return;
     }
     std::size_t bad = 0;
-    read_vertices(verts, transform, vertices, bad);
-    info.vertices += vertices.size();
+    read_vertices(verts, transform, vertices.points, bad);
+    vertices.classify(options.max_abs_coordinate);
+    info.vertices += vertices.points.size();
     note_bad_vertices(bad, "line " + std::to_string(line_no) + " \"vertices\"", path, problems);
     for (auto [id, object] : objects) converter.convert(id, object, vertices, templates);
   };
