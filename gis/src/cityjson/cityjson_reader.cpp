@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 
 namespace groundplan::gis {
@@ -155,6 +156,7 @@ struct Scratch {
   bool in_use = false;
 };
 constexpr std::size_t kKeepBytes = std::size_t{64} << 20;
+constexpr std::size_t kReadChunk = std::size_t{1} << 20;  // per VSIFReadL: progress moves while a file is read
 
 /// The thread's Scratch, or a fresh one when the thread is already inside read_cityjson (a callback that
 /// waits in TBB may run another file's task on this thread).
@@ -188,8 +190,10 @@ class ScratchLease {
 };
 
 /// The whole file into s.bytes, padded as simdjson needs (GDAL VSI: plain files, /vsigzip/, /vsizip/,
-/// /vsimem/). One allocation of the stated size (+ padding) when the size is known. Returns the length.
-std::size_t load(const std::string& path, std::uint64_t max_bytes, Scratch& s) {
+/// /vsimem/). One allocation of the stated size (+ padding) when the size is known. Read 1 MiB at a time,
+/// each told to `on_bytes` (progress). Returns the length.
+std::size_t load(const std::string& path, std::uint64_t max_bytes, const std::function<void(std::uint64_t)>& on_bytes,
+                 Scratch& s) {
   VsiFile holder;
   VSILFILE* f = open_or_throw(path, holder);
   VSIStatBufL st;
@@ -212,9 +216,11 @@ std::size_t load(const std::string& path, std::uint64_t max_bytes, Scratch& s) {
       throw InputError(path + ": larger than 4 GiB, the most a CityJSON file can be read as one document; convert it "
                               "to CityJSONSeq (cjseq cat, or cjio export jsonl) and read the .city.jsonl");
     if (s.capacity - length <= simdjson::SIMDJSON_PADDING) grow(std::max<std::size_t>(2 * s.capacity, 1 << 20));
-    const std::size_t got = VSIFReadL(s.bytes.get() + length, 1, s.capacity - length - simdjson::SIMDJSON_PADDING, f);
+    const std::size_t want = std::min<std::size_t>(s.capacity - length - simdjson::SIMDJSON_PADDING, kReadChunk);
+    const std::size_t got = VSIFReadL(s.bytes.get() + length, 1, want, f);
     length += got;
     if (max_bytes && length > max_bytes) throw too_many_bytes(path, max_bytes);
+    if (got && on_bytes) on_bytes(got);
     if (got == 0) break;
   }
   std::memset(s.bytes.get() + length, 0, simdjson::SIMDJSON_PADDING);
@@ -363,7 +369,7 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
                    std::vector<Problem>& problems, CityJsonInfo& info) {
   info = CityJsonInfo{};
   ScratchLease scratch;
-  const std::size_t length = load(path, options.max_bytes, *scratch);
+  const std::size_t length = load(path, options.max_bytes, options.on_bytes, *scratch);
   info.bytes = length;
   const simdjson::padded_string_view json(scratch->bytes.get(), length, scratch->capacity);
   ObjectConverter converter(path, options, on_mesh, problems, info);
@@ -535,6 +541,7 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
     buf.resize(at + got);
     info.bytes += got;
     if (options.max_bytes && info.bytes > options.max_bytes) throw too_many_bytes(path, options.max_bytes);
+    if (got && options.on_bytes) options.on_bytes(got);
     eof = got < kChunk;
     std::size_t scan = at;
     for (;;) {
