@@ -10,6 +10,7 @@
 #include <cpl_vsi.h>
 
 #include "cityjson/read_into.h"
+#include "gzip_progress.h"
 
 #include <algorithm>
 #include <cstring>
@@ -193,26 +194,38 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
                       " times its compressed size; stopped (gzip bomb?). If the file is genuine, gunzip it and read "
                       "the plain file");
   };
+  // on_bytes counts a file's bytes on disk (the progress total): a gzip input's packed bytes, scaled
+  // from the unpacked ones its reader is told (gzip_progress.h).
+  const bool gzip = open.rfind("/vsigzip/", 0) == 0;
+  std::optional<GzipProgress> packed;
+  if (gzip && options.on_bytes) packed.emplace(open.substr(9), options.on_bytes);
+  auto told_bytes = [&](std::uint64_t n) {
+    if (packed) packed->unpacked(n);
+    else if (options.on_bytes) options.on_bytes(n);
+  };
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
     opt.lod = options.lod;
-    opt.on_bytes = options.on_bytes;
     std::uint64_t unpacked = 0;
-    if (max_bytes)
+    if (max_bytes || options.on_bytes)
       opt.on_bytes = [&](std::uint64_t n) {
         unpacked += n;
-        if (unpacked > max_bytes) throw too_big(unpacked);
-        if (options.on_bytes) options.on_bytes(n);
+        if (max_bytes && unpacked > max_bytes) throw too_big(unpacked);
+        told_bytes(n);
       };
     read_citygml(open, opt, [&](Mesh&& m) {
       ++info.meshes;
       if (info.source_srs != info.citygml.srs_name) info.source_srs = info.citygml.srs_name;
       on_mesh(std::move(m));
     }, problems, info.citygml);
+    if (packed) packed->finish();
     return;
   }
   if (info.format == InputFormat::CityJson || info.format == InputFormat::CityJsonSeq) {
-    cityjson::read_into(open, options, max_bytes, on_mesh, problems, info);
+    ReadOptions with_bytes = options;
+    with_bytes.on_bytes = options.on_bytes ? std::function<void(std::uint64_t)>(told_bytes) : nullptr;
+    cityjson::read_into(open, with_bytes, max_bytes, on_mesh, problems, info);
+    if (packed) packed->finish();
     return;
   }
   if (info.format == InputFormat::Ogr) {

@@ -9,6 +9,7 @@
 
 #include <groundplan/error.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <utility>
@@ -78,6 +79,7 @@ struct Defects {
 /// Where a geometry's indices point, and how its vertices are placed (templates).
 struct VertexSource {
   const std::vector<Point3>* points = nullptr;
+  const std::uint8_t* defects = nullptr;  // VertexTable::defects of `points` where there is no matrix
   const double* matrix = nullptr;  // row-major 4x4 (GeometryInstance), or none
   Point3 ref;
 };
@@ -124,8 +126,15 @@ class GeometryWalker {
 
   VertexDefect vertex(std::uint64_t index, Point3& out) const {
     if (index >= src_.points->size()) return VertexDefect::BadIndex;
+    if (!src_.matrix) {  // checked once per vertex by VertexTable::classify
+      switch (src_.defects[index]) {
+        case VertexTable::kOk: out = (*src_.points)[index]; return VertexDefect::None;
+        case VertexTable::kNotFinite: return VertexDefect::NotFinite;
+        default: return VertexDefect::OutOfRange;
+      }
+    }
     Point3 p = (*src_.points)[index];
-    if (src_.matrix) {
+    {
       const double* m = src_.matrix;
       p = Point3{m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] + src_.ref.x,
                  m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7] + src_.ref.y,
@@ -151,6 +160,13 @@ class GeometryWalker {
       m_.ring_offsets.resize(rings_);
     }
     std::size_t ring_mark() const { return m_.vertices.size(); }
+    /// Room for `n` more points, growing geometrically (a hint: point() still checks).
+    void make_room(std::size_t n) {
+      if (m_.vertices.capacity() - m_.vertices.size() < n)
+        m_.vertices.reserve(std::max(m_.vertices.size() + n, 2 * m_.vertices.capacity()));
+      if (m_.indices.capacity() - m_.indices.size() < n)
+        m_.indices.reserve(std::max(m_.indices.size() + n, 2 * m_.indices.capacity()));
+    }
     void point(const Point3& p) {
       m_.indices.push_back(static_cast<std::uint32_t>(m_.vertices.size()));
       m_.vertices.push_back(p);
@@ -177,15 +193,35 @@ class GeometryWalker {
     bool done_ = false;
   };
 
+  /// The hot loop (~3/4 of the walk's instructions): points of the ring from `it` while they are indices of
+  /// good vertices of a geometry without a matrix, each checked once by VertexTable::classify. Returns
+  /// true at the ring's end; false at an element that needs a closer look (left at `it`).
+  [[gnu::flatten]] bool easy_points(dom::array::iterator& it, const dom::array::iterator& end, FaceWriter& face,
+                                    std::uint64_t& i) const {
+    if (src_.matrix) return it == end;
+    const Point3* points = src_.points->data();
+    const std::size_t n = src_.points->size();
+    const std::uint8_t* defects = src_.defects;
+    for (; it != end; ++it) {
+      if ((*it).get_uint64().get(i) != simdjson::SUCCESS || i >= n || defects[i] != VertexTable::kOk) return false;
+      face.point(points[i]);
+    }
+    return true;
+  }
+
   void surface(dom::element s, SurfaceKind kind) {
     FaceWriter face(mesh_);
     std::size_t ring_no = 0;
     for (dom::element ring : s.get_array()) {
       const std::size_t mark = face.ring_mark();
-      for (dom::element idx : ring.get_array()) {
-        std::uint64_t i = 0;
+      const dom::array indices = ring.get_array();
+      face.make_room(indices.size());
+      std::uint64_t i = 0;
+      for (dom::array::iterator it = indices.begin(), end = indices.end(); it != end; ++it) {
+        if (easy_points(it, end, face, i)) break;  // the ring's end
+        // *it is not an index of a good vertex without a matrix: what is it?
         Point3 p;
-        if (idx.get_uint64().get(i) != simdjson::SUCCESS) {
+        if ((*it).get_uint64().get(i) != simdjson::SUCCESS) {
           defects_.add("BAD_VERTEX_INDEX", "a vertex index is not a non-negative integer; its surface is dropped");
           return;
         }
@@ -230,10 +266,10 @@ class GeometryWalker {
   Defects& defects_;
 };
 
-std::vector<SurfaceKind> semantic_kinds(dom::element geometry, std::optional<dom::element>& values) {
-  std::vector<SurfaceKind> kinds;
+void semantic_kinds(const GeometryFields& geometry, std::vector<SurfaceKind>& kinds, std::optional<dom::element>& values) {
+  kinds.clear();
   dom::element sem;
-  if (geometry["semantics"].get(sem) != simdjson::SUCCESS || sem.is_null()) return kinds;
+  if (geometry.get(geometry.semantics).get(sem) != simdjson::SUCCESS || sem.is_null()) return;
   dom::element surfaces;
   if (sem["surfaces"].get(surfaces) == simdjson::SUCCESS)
     for (dom::element s : surfaces.get_array()) {
@@ -242,21 +278,35 @@ std::vector<SurfaceKind> semantic_kinds(dom::element geometry, std::optional<dom
     }
   dom::element v;
   if (sem["values"].get(v) == simdjson::SUCCESS) values = v;
-  return kinds;
 }
 
-/// A geometry with its LoD, resolved through a template where it is a GeometryInstance.
-struct Candidate {
-  dom::element geometry;  // the surface geometry (the template for an instance)
-  int levels = 0;
-  int major = 0, minor = 0;
-  bool instance = false;
-  double matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  std::uint64_t ref_index = 0;
-  int rank() const { return major * 10 + minor; }
-};
-
 }  // namespace
+
+GeometryFields::GeometryFields(dom::element geometry) {
+  dom::object o;
+  if ((object_error = geometry.get_object().get(o)) != simdjson::SUCCESS) return;
+  for (dom::key_value_pair f : o) {
+    const std::string_view k = f.key;
+    Field* slot = nullptr;
+    if (k == "boundaries") slot = &boundaries;
+    else if (k == "type") slot = &type;
+    else if (k == "lod") slot = &lod;
+    else if (k == "semantics") slot = &semantics;
+    else if (k == "template") slot = &template_index;
+    else if (k == "transformationMatrix") slot = &matrix;
+    if (slot && !slot->found) *slot = Field{f.value, true};  // the first, as a lookup by key finds
+  }
+}
+
+void VertexTable::classify(double max_abs) {
+  defects.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point3& p = points[i];
+    defects[i] = !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) ? kNotFinite
+                 : std::fabs(p.x) > max_abs || std::fabs(p.y) > max_abs || std::fabs(p.z) > max_abs ? kOutOfRange
+                                                                                                   : kOk;
+  }
+}
 
 Transform parse_transform(dom::element e, const std::string& file) {
   Transform t;
@@ -307,13 +357,32 @@ void add_vertex(std::vector<Point3>& out, const double* xyz, bool ok, const Tran
                        xyz[2] * t.scale[2] + t.translate[2]});
 }
 
-void ObjectConverter::convert(std::string_view id_view, dom::element object, const std::vector<Point3>& vertices,
+void ObjectConverter::convert(std::string_view id_view, dom::element object, const VertexTable& vertices,
                               const Templates& templates) {
   ++info_.city_objects;
-  const std::string id(id_view.substr(0, 256));
+  // The members used, in one pass over the object's fields (a lookup by key scans them each time); the
+  // first of a repeated key, as a lookup finds.
+  dom::element type_el, parents_el, children_el, attributes_el, geometry_el;
+  bool has_type = false, has_parents = false, has_children_el = false, has_attributes = false, has_geometry = false;
+  dom::object fields;
+  if (object.get_object().get(fields) == simdjson::SUCCESS)
+    for (dom::key_value_pair f : fields) {
+      const std::string_view k = f.key;
+      if (k == "geometry") {
+        if (!has_geometry) geometry_el = f.value, has_geometry = true;
+      } else if (k == "type") {
+        if (!has_type) type_el = f.value, has_type = true;
+      } else if (k == "parents") {
+        if (!has_parents) parents_el = f.value, has_parents = true;
+      } else if (k == "children") {
+        if (!has_children_el) children_el = f.value, has_children_el = true;
+      } else if (k == "attributes") {
+        if (!has_attributes) attributes_el = f.value, has_attributes = true;
+      }
+    }
   std::string_view type;
-  dom::element type_el;
-  if (object["type"].get(type_el) != simdjson::SUCCESS || type_el.get_string().get(type) != simdjson::SUCCESS) {
+  if (!has_type || type_el.get_string().get(type) != simdjson::SUCCESS) {
+    const std::string id(id_view.substr(0, 256));
     problems_.push_back(Problem{id, file_, "read", "BAD_CITYOBJECT", "city object \"" + id + "\" has no \"type\"; skipped"});
     return;
   }
@@ -331,67 +400,66 @@ void ObjectConverter::convert(std::string_view id_view, dom::element object, con
   mesh.indices.clear();
   mesh.ring_offsets.assign(1, 0);
   mesh.faces.clear();
-  mesh.source_id = id;
+  mesh.source_id.assign(id_view.substr(0, 256));  // into the kept capacity; `id` below is this string
   mesh.parent_id.clear();
   mesh.name.clear();
   mesh.measured_height = -1;
   mesh.source_file = file_;
+  const std::string& id = mesh.source_id;
   Defects defects;
   bool has_children = false;
   std::string skipped_types;  // geometry types that are not surfaces (MultiPoint, MultiLineString)
-  std::vector<Candidate> candidates;
+  std::vector<Candidate>& candidates = candidates_;
+  candidates.clear();
   try {
-    dom::element el;
     dom::array arr;
-    if (part && object["parents"].get(el) == simdjson::SUCCESS && el.get_array().get(arr) == simdjson::SUCCESS &&
-        arr.size() > 0) {
+    if (part && has_parents && parents_el.get_array().get(arr) == simdjson::SUCCESS && arr.size() > 0) {
       std::string_view parent;
-      if (arr.at(0).get_string().get(parent) == simdjson::SUCCESS) mesh.parent_id = std::string(parent.substr(0, 256));
+      if ((*arr.begin()).get_string().get(parent) == simdjson::SUCCESS) mesh.parent_id = std::string(parent.substr(0, 256));
     }
-    if (object["children"].get(el) == simdjson::SUCCESS && el.get_array().get(arr) == simdjson::SUCCESS)
-      has_children = arr.size() > 0;
+    if (has_children_el && children_el.get_array().get(arr) == simdjson::SUCCESS) has_children = arr.size() > 0;
     double h = 0;
-    if (object["attributes"].get(el) == simdjson::SUCCESS && el["measuredHeight"].get_double().get(h) == simdjson::SUCCESS &&
-        std::isfinite(h))
+    if (has_attributes && attributes_el["measuredHeight"].get_double().get(h) == simdjson::SUCCESS && std::isfinite(h))
       mesh.measured_height = h;
-    if (object["geometry"].get(el) == simdjson::SUCCESS && el.get_array().get(arr) == simdjson::SUCCESS) {
+    if (has_geometry && geometry_el.get_array().get(arr) == simdjson::SUCCESS) {
       for (dom::element g : arr) {
         try {
           Candidate c;
-          std::string_view gtype = g["type"].get_string();
-          dom::element lod_el;
-          dom::element surface_geometry = g;
+          const GeometryFields fields_of_g(g);
+          std::string_view gtype = fields_of_g.get(fields_of_g.type).get_string();
+          c.geometry = fields_of_g;
           if (gtype == "GeometryInstance") {
-            const std::uint64_t tpl = g["template"].get_uint64();
+            const std::uint64_t tpl = fields_of_g.get(fields_of_g.template_index).get_uint64();
             if (tpl >= templates.geometries.size()) {
               defects.add("BAD_TEMPLATE", "GeometryInstance names template " + std::to_string(tpl) + " of " +
                                               std::to_string(templates.geometries.size()) + "; it is dropped");
               continue;
             }
-            surface_geometry = templates.geometries[tpl];
-            gtype = surface_geometry["type"].get_string();
-            dom::array m = g["transformationMatrix"].get_array();
+            c.geometry = GeometryFields(templates.geometries[tpl]);
+            gtype = c.geometry.get(c.geometry.type).get_string();
+            dom::array m = fields_of_g.get(fields_of_g.matrix).get_array();
             if (m.size() != 16) {
               defects.add("BAD_TEMPLATE", "a GeometryInstance's transformationMatrix does not have 16 values; dropped");
               continue;
             }
-            for (std::size_t i = 0; i < 16; ++i) c.matrix[i] = m.at(i).get_double();
-            dom::array b = g["boundaries"].get_array();
+            std::size_t i = 0;
+            for (dom::element e : m) c.matrix[i++] = e.get_double();
+            dom::array b = fields_of_g.get(fields_of_g.boundaries).get_array();
             if (b.size() != 1) {
               defects.add("BAD_TEMPLATE", "a GeometryInstance's boundaries must hold one reference vertex; dropped");
               continue;
             }
-            c.ref_index = b.at(0).get_uint64();
+            c.ref_index = (*b.begin()).get_uint64();
             c.instance = true;
           }
-          c.geometry = surface_geometry;
           c.levels = surface_levels(gtype);
           if (c.levels < 0) {
             if (skipped_types.find(gtype) == std::string::npos)
               skipped_types += (skipped_types.empty() ? "" : ", ") + std::string(gtype.substr(0, 40));
             continue;
           }
-          if (surface_geometry["lod"].get(lod_el) != simdjson::SUCCESS || !parse_lod(lod_el, c.major, c.minor)) {
+          dom::element lod_el;
+          if (c.geometry.get(c.geometry.lod).get(lod_el) != simdjson::SUCCESS || !parse_lod(lod_el, c.major, c.minor)) {
             defects.add("BAD_LOD", "a " + std::string(gtype) + " has no valid \"lod\" (\"0\"..\"4\" or \"2.2\" ...); "
                                    "it is dropped");
             continue;
@@ -405,7 +473,6 @@ void ObjectConverter::convert(std::string_view id_view, dom::element object, con
   } catch (const simdjson::simdjson_error& err) {
     defects.add("BAD_CITYOBJECT", std::string("the object is malformed (") + err.what() + ")");
   }
-
   auto report_defects = [&] {
     for (const Defects::Entry& e : defects.entries)
       problems_.push_back(Problem{id, file_, "read", e.code,
@@ -449,21 +516,22 @@ void ObjectConverter::convert(std::string_view id_view, dom::element object, con
     if (c.rank() != best) continue;
     try {
       VertexSource src;
-      src.points = &vertices;
+      src.points = &vertices.points;
+      src.defects = vertices.defects.data();
       if (c.instance) {
-        if (c.ref_index >= vertices.size() || !std::isfinite(vertices[c.ref_index].x)) {
+        if (c.ref_index >= vertices.points.size() || !std::isfinite(vertices.points[c.ref_index].x)) {
           defects.add("BAD_VERTEX_INDEX", "a GeometryInstance's reference vertex " + std::to_string(c.ref_index) +
                                               " is out of range or not finite; it is dropped");
           continue;
         }
         src.points = &templates.vertices;
         src.matrix = c.matrix;
-        src.ref = vertices[c.ref_index];
+        src.ref = vertices.points[c.ref_index];
       }
       std::optional<dom::element> values;
-      const std::vector<SurfaceKind> kinds = semantic_kinds(c.geometry, values);
-      GeometryWalker walker(src, kinds, static_cast<std::uint8_t>(c.major), opt_.max_abs_coordinate, mesh, defects);
-      walker.walk(c.geometry["boundaries"], values, c.levels);
+      semantic_kinds(c.geometry, kinds_, values);
+      GeometryWalker walker(src, kinds_, static_cast<std::uint8_t>(c.major), opt_.max_abs_coordinate, mesh, defects);
+      walker.walk(c.geometry.get(c.geometry.boundaries), values, c.levels);
     } catch (const simdjson::simdjson_error& err) {
       defects.add("BAD_GEOMETRY", std::string("a geometry's boundaries are malformed (") + err.what() +
                                       "); what was read of it is kept");

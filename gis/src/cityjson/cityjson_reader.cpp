@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 
 namespace groundplan::gis {
@@ -151,10 +152,11 @@ struct Scratch {
   std::unique_ptr<char[]> bytes;
   std::size_t capacity = 0;
   dom::parser whole;
-  std::vector<Point3> vertices;
+  cityjson::VertexTable vertices;
   bool in_use = false;
 };
 constexpr std::size_t kKeepBytes = std::size_t{64} << 20;
+constexpr std::size_t kReadChunk = std::size_t{1} << 20;  // per VSIFReadL: progress moves while a file is read
 
 /// The thread's Scratch, or a fresh one when the thread is already inside read_cityjson (a callback that
 /// waits in TBB may run another file's task on this thread).
@@ -176,7 +178,7 @@ class ScratchLease {
       s_->bytes.reset();
       s_->capacity = 0;
       s_->whole = dom::parser{};
-      std::vector<Point3>().swap(s_->vertices);
+      s_->vertices = cityjson::VertexTable{};
     }
   }
   Scratch& operator*() { return *s_; }
@@ -188,8 +190,10 @@ class ScratchLease {
 };
 
 /// The whole file into s.bytes, padded as simdjson needs (GDAL VSI: plain files, /vsigzip/, /vsizip/,
-/// /vsimem/). One allocation of the stated size (+ padding) when the size is known. Returns the length.
-std::size_t load(const std::string& path, std::uint64_t max_bytes, Scratch& s) {
+/// /vsimem/). One allocation of the stated size (+ padding) when the size is known. Read 1 MiB at a time,
+/// each told to `on_bytes` (progress). Returns the length.
+std::size_t load(const std::string& path, std::uint64_t max_bytes, const std::function<void(std::uint64_t)>& on_bytes,
+                 Scratch& s) {
   VsiFile holder;
   VSILFILE* f = open_or_throw(path, holder);
   VSIStatBufL st;
@@ -212,9 +216,11 @@ std::size_t load(const std::string& path, std::uint64_t max_bytes, Scratch& s) {
       throw InputError(path + ": larger than 4 GiB, the most a CityJSON file can be read as one document; convert it "
                               "to CityJSONSeq (cjseq cat, or cjio export jsonl) and read the .city.jsonl");
     if (s.capacity - length <= simdjson::SIMDJSON_PADDING) grow(std::max<std::size_t>(2 * s.capacity, 1 << 20));
-    const std::size_t got = VSIFReadL(s.bytes.get() + length, 1, s.capacity - length - simdjson::SIMDJSON_PADDING, f);
+    const std::size_t want = std::min<std::size_t>(s.capacity - length - simdjson::SIMDJSON_PADDING, kReadChunk);
+    const std::size_t got = VSIFReadL(s.bytes.get() + length, 1, want, f);
     length += got;
     if (max_bytes && length > max_bytes) throw too_many_bytes(path, max_bytes);
+    if (got && on_bytes) on_bytes(got);
     if (got == 0) break;
   }
   std::memset(s.bytes.get() + length, 0, simdjson::SIMDJSON_PADDING);
@@ -318,7 +324,7 @@ bool read_whole_dom(Scratch& scratch, std::size_t length, const std::string& pat
     }
     finish_top(top, path, problems, info);  // the checks; no raw vertices on this path
     // Straight into the thread's vector (its pages stay mapped from one file to the next).
-    std::vector<Point3>& vertices = scratch.vertices;
+    std::vector<Point3>& vertices = scratch.vertices.points;
     vertices.clear();
     std::size_t n = 0, bad = 0;
     for (dom::array a : vertex_arrays) n += a.size();
@@ -341,12 +347,13 @@ bool read_whole_dom(Scratch& scratch, std::size_t length, const std::string& pat
       }
     info.vertices = vertices.size();
     note_bad_vertices(bad, "\"vertices\"", path, problems);
+    scratch.vertices.classify(options.max_abs_coordinate);
     for (dom::key_value_pair field : root) {
       if (field.key != "CityObjects") continue;
       for (dom::key_value_pair object : field.value.get_object()) {
         ++at_object;
         object.value.get_object().value();  // as the On-Demand path: a city object that is no object ends the file
-        converter.convert(object.key, object.value, vertices, top.templates);
+        converter.convert(object.key, object.value, scratch.vertices, top.templates);
       }
     }
   } catch (const simdjson::simdjson_error& e) {
@@ -362,7 +369,7 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
                    std::vector<Problem>& problems, CityJsonInfo& info) {
   info = CityJsonInfo{};
   ScratchLease scratch;
-  const std::size_t length = load(path, options.max_bytes, *scratch);
+  const std::size_t length = load(path, options.max_bytes, options.on_bytes, *scratch);
   info.bytes = length;
   const simdjson::padded_string_view json(scratch->bytes.get(), length, scratch->capacity);
   ObjectConverter converter(path, options, on_mesh, problems, info);
@@ -404,7 +411,9 @@ void read_cityjson(const std::string& path, const CityJsonOptions& options, cons
         top.has_objects = true;  // second pass
       }
     }
-    const std::vector<Point3> vertices = finish_top(top, path, problems, info);
+    cityjson::VertexTable vertices;
+    vertices.points = finish_top(top, path, problems, info);
+    vertices.classify(options.max_abs_coordinate);
 
     // A second iteration rather than doc.rewind(): UBSan finds rewind() reading a null parser after some
     // malformed first passes (simdjson 3.0.1); the same parser keeps its buffers, only stage 1 runs again.
@@ -443,7 +452,7 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
   std::unique_ptr<dom::parser> header_parser = make_dom_parser(options.max_depth);  // keeps the templates alive
   std::unique_ptr<dom::parser> line_parser = make_dom_parser(options.max_depth);
   Templates templates;
-  std::vector<Point3> vertices;
+  cityjson::VertexTable vertices;
   ObjectConverter converter(path, options, on_mesh, problems, info);
   bool have_header = false;
 
@@ -505,8 +514,9 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
       return;
     }
     std::size_t bad = 0;
-    read_vertices(verts, transform, vertices, bad);
-    info.vertices += vertices.size();
+    read_vertices(verts, transform, vertices.points, bad);
+    vertices.classify(options.max_abs_coordinate);
+    info.vertices += vertices.points.size();
     note_bad_vertices(bad, "line " + std::to_string(line_no) + " \"vertices\"", path, problems);
     for (auto [id, object] : objects) converter.convert(id, object, vertices, templates);
   };
@@ -531,6 +541,7 @@ void read_cityjson_seq(const std::string& path, const CityJsonOptions& options, 
     buf.resize(at + got);
     info.bytes += got;
     if (options.max_bytes && info.bytes > options.max_bytes) throw too_many_bytes(path, options.max_bytes);
+    if (got && options.on_bytes) options.on_bytes(got);
     eof = got < kChunk;
     std::size_t scan = at;
     for (;;) {

@@ -9,6 +9,7 @@ void read_into(const std::string& path, const ReadOptions& options, std::uint64_
   opt.lod = options.lod;
   opt.lod_refinement = options.lod_refinement;
   if (max_bytes) opt.max_bytes = max_bytes;
+  opt.on_bytes = options.on_bytes;
   // The CRS as the pipeline reads it for CityGML: set before the first mesh (the pipeline makes the
   // working frame then; CityJSON's metadata is read before any object), and again at the end.
   struct Publish {

@@ -9,6 +9,7 @@
 #include <cpl_vsi.h>
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -125,6 +126,53 @@ TEST(CompressedInput, GzipBombStopsAtTheRatio) {
     opt.gzip_max_ratio = 100000;  // the same file read whole when the limit allows it
     EXPECT_NO_THROW(test::read(path, opt)) << name;
     opt.gzip_max_ratio = 100;
+  }
+}
+
+// -progress for a .gz moves with its packed bytes (the progress total counts file sizes on disk): read_any
+// tells ReadOptions::on_bytes packed bytes while it reads, ending exactly at the packed size; a plain file
+// gets its own bytes, also while it is read, not in one lump at the end.
+TEST(CompressedInput, ProgressCountsPackedBytesWhileReading) {
+  const test::TempDir dir("groundplan_gz_test");
+  // ~3.5 MB of text each that packs a few times (digits from an LCG), so reading takes several chunks.
+  std::uint64_t x = 12345;
+  auto digits = [&] {
+    x = x * 6364136223846793005ull + 1442695040888963407ull;
+    return std::to_string(x >> 20);
+  };
+  std::string json = R"({"type":"CityJSON","version":"2.0","CityObjects":{)";
+  std::string seq = R"({"type":"CityJSON","version":"2.0","CityObjects":{},"vertices":[]})" "\n";
+  std::string gml = "<?xml version=\"1.0\"?>\n<core:CityModel xmlns:core=\"http://www.opengis.net/citygml/2.0\">\n";
+  for (int i = 0; i < 60000; ++i) {
+    const std::string d = digits();
+    json += (i ? ",\"b" : "\"b") + std::to_string(i) + R"(":{"type":"GenericCityObject","attributes":{"n":")" + d + "\"}}";
+    seq += R"({"type":"CityJSONFeature","id":"f)" + std::to_string(i) + R"(","CityObjects":{},"vertices":[],"n":")" + d + "\"}\n";
+    gml += "<!-- " + d + " " + d + " " + d + " " + std::to_string(i) + " -->\n";
+  }
+  json += R"(},"vertices":[]})";
+  gml += "</core:CityModel>\n";
+  for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
+           {"p.city.json", json}, {"p.city.jsonl", seq}, {"p.gml", gml}}) {
+    ASSERT_GT(text.size(), 3u << 20) << name;
+    const std::string plain = (dir.path / name).string(), gz = plain + ".gz";
+    std::ofstream(plain, std::ios::binary) << text;
+    write_gz(gz, text);
+    for (const std::string& path : {plain, gz}) {
+      const std::uint64_t size = std::filesystem::file_size(path);
+      std::vector<std::uint64_t> told;
+      gis::ReadOptions opt;
+      opt.on_bytes = [&](std::uint64_t n) { told.push_back(n); };
+      test::read(path, opt);
+      std::uint64_t sum = 0;
+      for (std::uint64_t n : told) {
+        EXPECT_GT(n, 0u) << path;
+        sum += n;
+      }
+      EXPECT_EQ(sum, size) << path;                        // exactly the file's bytes on disk
+      ASSERT_GE(told.size(), 3u) << path;                  // told while reading, not once at the end
+      EXPECT_LT(told.front(), size / 2) << path;           // the first report is not most of the file
+      if (path == gz) EXPECT_LT(size, text.size() / 2) << path;  // packed: a count of unpacked bytes would overshoot
+    }
   }
 }
 

@@ -5,10 +5,13 @@
 // metadata.referenceSystem (CityJSONSeq: the first line's), which gis/crs.h turns into the working
 // frame exactly as a CityGML srsName.
 //
-// Parser: simdjson (On-Demand for the file, its DOM for one city object or one CityJSONSeq line at a
-// time). A CityJSON file is held in memory as bytes plus simdjson's structural index (no DOM of the
-// whole file); files up to 4 GiB (simdjson's limit). CityJSONSeq is read line by line: memory is
-// bounded by the longest line, whatever the file's size.
+// Parser: simdjson. A valid CityJSON file is parsed once into simdjson's DOM (its runtime-dispatched
+// kernel) and converted from it, so it is held whole: bytes, tape and index, ~6 bytes a byte, files up
+// to 4 GiB (simdjson's limit). Why not streamed: its "vertices" may follow "CityObjects" (3DBAG), and
+// simdjson 3.0.1's On-Demand also needs the whole document and a structural index of it before the
+// first value (README, "Memory and speed"). A file with a broken object is read again object by object.
+// CityJSONSeq is read line by line, one DOM per line: memory is bounded by the longest line, whatever
+// the file's size.
 //
 // What becomes a mesh: every Building / BuildingPart with surface geometry (MultiSurface,
 // CompositeSurface, Solid, MultiSolid, CompositeSolid, GeometryInstance of such a template). A
@@ -25,6 +28,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,6 +49,8 @@ struct CityJsonOptions {
   /// Bytes read (unpacked) after which reading stops with InputError; 0: no limit. read_any sets it for a
   /// gzip input (ReadOptions::gzip_max_ratio), so that a gzip bomb cannot fill memory.
   std::uint64_t max_bytes = 0;
+  /// Told the bytes as they are read (1 MiB at a time; unpacked for a gzip input), for progress; may be empty.
+  std::function<void(std::uint64_t)> on_bytes;
 };
 
 struct CityJsonInfo {

@@ -41,7 +41,9 @@ struct ReadOptions {
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
   OgrInputOptions ogr;          // any OGR vector source: layers, filter, ids, grouping (issue 22)
-  std::function<void(std::uint64_t)> on_bytes;  // CityGML: told the bytes as they are read (progress); may be empty
+  // CityGML, CityJSON: told the file's bytes as they are read (progress; a .gz's packed bytes, scaled from
+  // the unpacked ones read: gzip_progress.h); may be empty
+  std::function<void(std::uint64_t)> on_bytes;
   CityJsonOptions cityjson;     // limits (lod and lod_refinement above win over its own)
   /// A gzip input (is_gzip_input_name) may expand to at most this many times its compressed size, and at
   /// least gzip_min_bytes: a gzip bomb then stops with an InputError naming the file instead of filling
