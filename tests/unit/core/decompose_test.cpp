@@ -341,6 +341,21 @@ TEST(DecomposeFootprint, UpperStoreyWiderOnEverySide) {
   }
 }
 
+TEST(DecomposeFootprint, PartOnHigherGroundBesideATallerOneKeepsItsFootprint) {
+  // Two closed parts side by side (issue 21, contacts.cpp rule c): B stands 0.5 m higher than A and
+  // rises 7.5 m, so its floor's west edge lies in A's east wall, which goes on below it. That is how a
+  // balcony slab leans on a wall too, but B stands lower above A's bottom than it is tall: its floor
+  // is ground and the footprint is both parts. A slab 0.2 m thick at the same place hangs.
+  for (const double top : {8.0, 0.7}) {
+    Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 10, true, true);
+    append(m, prism(rect(10, 2, 14, 8), {}, flat(0.5), top, true, true));
+    const DecomposeResult r = decompose_footprint(m);
+    const Check c = compare(r, top > 1 ? "POLYGON((0 0,10 0,10 2,14 2,14 8,10 8,10 10,0 10,0 0))" : kSquare);
+    EXPECT_LT(c.symdiff, kEps) << "top " << top << ": area " << c.area;
+    EXPECT_FALSE(r.stats.shadow) << top;
+  }
+}
+
 TEST(DecomposeFootprint, DisconnectedParts) {
   Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, true, true);
   append(m, prism(rect(30, 0, 40, 5), {}, flat(12), 20, false, true));

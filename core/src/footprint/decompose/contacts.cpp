@@ -13,9 +13,11 @@
 //      soffit (a slab roof on walls, a box set on a lower one that it overhangs);
 //  (b) a lower-boundary edge of the walls on a ceiling facet: the walls stand on a roof (a box set
 //      on another), a ceiling boundary as in the paper, so no footprint edge.
-// Not done: a floor facet's edge on a wall facet that goes on below it (a balcony slab against a
-// wall) does not make the floor hang, because a building part on slightly higher ground beside a
-// taller one looks the same (Berlin LoD2 sample: two buildings lost half their footprint).
+//  (c) a floor facet's edge on a wall facet that goes on below it (a balcony slab against a wall):
+//      the floor hangs when it lies higher above the bottom of the part it leans on than its own part
+//      reaches above it. A building part on slightly higher ground beside a taller one looks the same
+//      but for the heights: it stands 0.5 m up and rises 8 m (Berlin LoD2 sample), where a balcony
+//      slab stands 3 m up and is 0.2 m thick.
 // Only between different parts (components): one part's own faces already share their edges.
 // Holes of the touched face are not looked at (an edge over a hole counts as on the face).
 #include "footprint/decompose/decomposer.h"
@@ -107,7 +109,9 @@ void Decomposer::find_contacts() {
     const std::uint32_t comp = ws_.face_comp[any];
     const bool rule_a = wall_down && !floor;
     const bool rule_b = wall_up && !wall_down && !ceiling && !floor_hanging;
-    if (!rule_a && !rule_b) continue;
+    const bool rule_c = floor && !floor_hanging && !wall_down;
+    if (!rule_a && !rule_b && !rule_c) continue;
+    const double z_edge = std::min(p.z, q.z);
     for (std::uint32_t f = 0; f < nf; ++f) {
       const FaceInfo& fi = ws_.faces[f];
       if (ws_.face_comp[f] == comp) continue;
@@ -116,6 +120,16 @@ void Decomposer::find_contacts() {
         ++stats_->contacts;
       } else if (rule_b && fi.cls == kCeiling && edge_on_face(f, p, q)) {
         ws_.on_roof[g] = 1;
+        ++stats_->contacts;
+        break;
+      } else if (rule_c && fi.cls == kWall && fi.lo.z < z_edge - tol_ &&
+                 z_edge - ws_.comp_lo[ws_.face_comp[f]].z > ws_.comp_hi[comp].z - std::max(p.z, q.z) &&
+                 edge_on_face(f, p, q)) {
+        for (std::uint32_t i = 0; i < c; ++i) {
+          const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
+          if (ws_.faces[h.face].cls == kFloor) ws_.hanging[root(h.face)] = 1, ws_.hanging[h.face] = 1;
+        }
+        hung = true;
         ++stats_->contacts;
         break;
       }

@@ -28,6 +28,12 @@ constexpr std::uint32_t kBad = kNone - 1;  // a vertex with NaN or infinite coor
 /// A wall facet "rises" from an edge when the in-plane direction into it has at least this z
 /// component (unit vectors): vertical edges (0) and edges of walls leaning < 0.6° are neither.
 constexpr double kRise = 0.01;
+/// A floor patch from whose edges walls go down is a soffit (it hangs) when its mean depth beyond those
+/// edges (plan area / their plan length) is at most this many times the walls' drop below it; deeper,
+/// it is a step of the ground (a building on a slope, its floor following the terrain). A cantilever
+/// reaches out about as far as it stands high (stepped_ground in tests/support/known_footprints.cpp:
+/// 10 m deep over a 2 m riser; cantilever: 2 m over 3 m; boxed eaves: 0.9 m over 3 m).
+constexpr double kStepDepthPerDrop = 2;
 
 struct V3 {
   double x = 0, y = 0, z = 0;
@@ -183,6 +189,11 @@ struct Workspace {
   std::vector<std::int32_t> poly_of_loop;
   std::vector<std::uint32_t> floor_uf;
   std::vector<std::uint8_t> hanging;
+  /// Floor facets of a patch from whose edge a wall goes down but too little for its depth to be a
+  /// soffit: a step of the ground under a building on a slope (classification.cpp); the wall going
+  /// down is the riser, and the patch's edge on it bounds the footprint (lower_boundary.cpp).
+  std::vector<std::uint8_t> step_floor;
+  std::vector<double> patch_plan_area, patch_down_len, patch_drop;  // per floor patch root, while hanging
   std::vector<std::uint32_t> face_pts_start;  // contacts.cpp: each face's outer ring, projected along its normal
   std::vector<Point2> face_pts;
   std::vector<std::uint8_t> on_roof;  // per edge group: its walls stand on another part's ceiling (contacts.cpp)
