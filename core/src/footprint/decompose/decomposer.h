@@ -11,6 +11,8 @@
 //   lower_boundary.cpp  5. footprint edges: lower boundary of the walls, local minima
 //   loops.cpp           6. footprint edges chained into loops (3D, then in plan view)
 //   polygons.cpp        7. loops to polygons with holes
+//   unite.cpp           7b. one footprint's polygons united
+//   plan_faces.cpp      7c. when the loops miss: the lower boundary closed in plan
 //   shadow.cpp          8. the shadow, when the loops miss where the building stands
 // The per-vertex helpers of the weld, called from the ring pass in topology.cpp, stay inline here.
 #include "footprint/decompose.h"
@@ -34,6 +36,9 @@ constexpr double kRise = 0.01;
 /// reaches out about as far as it stands high (stepped_ground in tests/support/known_footprints.cpp:
 /// 10 m deep over a 2 m riser; cantilever: 2 m over 3 m; boxed eaves: 0.9 m over 3 m).
 constexpr double kStepDepthPerDrop = 2;
+/// Stage 7c (plan_faces.cpp): lower-boundary ends this close in plan are one point when the loops
+/// failed (SketchUp parts ending 7 to 8 cm apart: Macky). Metres.
+constexpr double kPlanGap_m = 0.1;
 
 struct V3 {
   double x = 0, y = 0, z = 0;
@@ -494,6 +499,12 @@ class Decomposer {
   /// building stands. Open chains inside a loop (a part standing on another) or above every loop
   /// (a balcony, a canopy: floating slabs are local minima too, but not ground) do not count.
   bool open_outside_loops() const;
+
+  // ---- 7c. the lower boundary closed in plan, before the shadow (plan_faces.cpp) ------------------
+  /// Every lower-boundary edge in plan, undirected, ends within kPlanGap_m one point, dangling chains
+  /// pruned; the union of the bounded faces into `out`. False (out untouched) when over a tenth of
+  /// the lower boundary was pruned outside those faces, or no face closed.
+  bool close_in_plan(std::vector<Polygon>& out);
 
   // ---- 8. the shadow: last resort (shadow.cpp) ------------------------------------------------------
   /// Rule 3: the loops miss where the building stands (a mesh full of gaps, walls
