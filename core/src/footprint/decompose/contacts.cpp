@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace groundplan::footprint::detail {
 
@@ -46,6 +47,71 @@ void Decomposer::project_faces() {
     }
   }
   start[nf] = static_cast<std::uint32_t>(pts.size());
+}
+
+void Decomposer::index_faces() {
+  auto& G = ws_.grid;
+  const std::size_t nf = ws_.faces.size();
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  std::size_t used = 0;
+  auto usable = [&](const FaceInfo& fi) { return fi.cls != kSkipped && fi.len > 0; };
+  for (const FaceInfo& fi : ws_.faces)
+    if (usable(fi)) x0 = std::min(x0, fi.lo.x), y0 = std::min(y0, fi.lo.y), x1 = std::max(x1, fi.hi.x), y1 = std::max(y1, fi.hi.y), ++used;
+  G.n = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(used))), 1, 64);
+  G.x0 = x0, G.y0 = y0;
+  G.sx = G.n / std::max(x1 - x0, 1e-9), G.sy = G.n / std::max(y1 - y0, 1e-9);
+  const std::size_t cells = static_cast<std::size_t>(G.n) * G.n;
+  auto cx = [&](double x) { return std::clamp(static_cast<int>((x - G.x0) * G.sx), 0, G.n - 1); };
+  auto cy = [&](double y) { return std::clamp(static_cast<int>((y - G.y0) * G.sy), 0, G.n - 1); };
+  for (int k = 0; k < 2; ++k) G.start[k].assign(cells + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::uint32_t f = 0; f < nf; ++f) {
+      const FaceInfo& fi = ws_.faces[f];
+      if (!usable(fi)) continue;
+      const int k = fi.cls == kWall;
+      auto& start = G.start[k];
+      for (int j = cy(fi.lo.y), j1 = cy(fi.hi.y); j <= j1; ++j)
+        for (int i = cx(fi.lo.x), i1 = cx(fi.hi.x); i <= i1; ++i) {
+          const std::size_t c = static_cast<std::size_t>(j) * G.n + i;
+          if (pass == 0) ++start[c + 1];
+          else G.faces[k][start[c]++] = f;  // start[c] used as the cursor, restored below
+        }
+    }
+    for (int k = 0; k < 2; ++k) {
+      auto& start = G.start[k];
+      if (pass == 0) {
+        for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+        G.faces[k].resize(start[cells]);
+      } else {
+        for (std::size_t c = cells; c > 0; --c) start[c] = start[c - 1];
+        start[0] = 0;
+      }
+    }
+  }
+  G.stamp.assign(nf, 0);
+  G.gen = 0;
+}
+
+void Decomposer::faces_near(const V3& p, const V3& q, bool walls) {
+  auto& G = ws_.grid;
+  G.near.clear();
+  ++G.gen;
+  auto cx = [&](double x) { return std::clamp(static_cast<int>((x - G.x0) * G.sx), 0, G.n - 1); };
+  auto cy = [&](double y) { return std::clamp(static_cast<int>((y - G.y0) * G.sy), 0, G.n - 1); };
+  const int i0 = cx(std::min(p.x, q.x) - tol_), i1 = cx(std::max(p.x, q.x) + tol_);
+  const int j0 = cy(std::min(p.y, q.y) - tol_), j1 = cy(std::max(p.y, q.y) + tol_);
+  for (int k = 0; k <= int(walls); ++k)
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t c = static_cast<std::size_t>(j) * G.n + i;
+        for (std::uint32_t e = G.start[k][c]; e < G.start[k][c + 1]; ++e) {
+          const std::uint32_t f = G.faces[k][e];
+          if (G.stamp[f] != G.gen) G.stamp[f] = G.gen, G.near.push_back(f);
+        }
+      }
+  // Rule c stops at the first wall it finds and rule b at the first ceiling: when both may apply,
+  // the face of smaller index decides, as it did when every face was tried in order.
+  if (walls) std::sort(G.near.begin(), G.near.end());
 }
 
 bool Decomposer::edge_on_face(std::uint32_t f, const V3& p, const V3& q) const {
@@ -83,6 +149,7 @@ void Decomposer::find_contacts() {
   for (const FaceInfo& fi : ws_.faces) any_floor |= fi.cls == kFloor, any_ceiling |= fi.cls == kCeiling;
   if (!any_floor && !any_ceiling) return;
   project_faces();
+  index_faces();
   const std::size_t nf = ws_.faces.size(), ng = ws_.group_count.size();
   auto& par = ws_.floor_uf;
   auto root = [&](std::uint32_t x) {
@@ -112,7 +179,8 @@ void Decomposer::find_contacts() {
     const bool rule_c = floor && !floor_hanging && !wall_down;
     if (!rule_a && !rule_b && !rule_c) continue;
     const double z_edge = std::min(p.z, q.z);
-    for (std::uint32_t f = 0; f < nf; ++f) {
+    faces_near(p, q, rule_c);  // the faces whose box could hold the edge
+    for (const std::uint32_t f : ws_.grid.near) {
       const FaceInfo& fi = ws_.faces[f];
       if (ws_.face_comp[f] == comp) continue;
       if (rule_a && fi.cls == kFloor && !ws_.hanging[f] && edge_on_face(f, p, q)) {

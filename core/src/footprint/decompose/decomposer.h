@@ -202,6 +202,16 @@ struct Workspace {
   std::vector<std::uint32_t> face_pts_start;  // contacts.cpp: each face's outer ring, projected along its normal
   std::vector<Point2> face_pts;
   std::vector<std::uint8_t> on_roof;  // per edge group: its walls stand on another part's ceiling (contacts.cpp)
+  /// contacts.cpp: the used faces bucketed by their plan boxes in an n x n grid (CSR), so that an edge
+  /// is tried against the faces near it, not all of them; floors and ceilings (rules a, b) apart from
+  /// walls (rule c), which are most faces and asked for least.
+  struct FaceGrid {
+    int n = 1;
+    double x0 = 0, y0 = 0, sx = 1, sy = 1;  // cell of x: (x - x0) * sx, clamped
+    std::vector<std::uint32_t> start[2], faces[2];  // [0] floors and ceilings, [1] walls
+    std::vector<std::uint32_t> stamp, near;
+    std::uint32_t gen = 0;
+  } grid;
 };
 
 /// Half-edge h, of the undirected edge lo < hi, into its group (groups numbered in order of first
@@ -455,6 +465,11 @@ class Decomposer {
   void find_contacts();
   /// Each used face's outer ring projected along its normal's largest component (face_pts).
   void project_faces();
+  /// ws_.grid over the used faces' plan boxes.
+  void index_faces();
+  /// The used faces (floors and ceilings, and walls when `walls`) whose plan box meets the edge p q's
+  /// widened by tol: ws_.grid.near, in increasing order when `walls`.
+  void faces_near(const V3& p, const V3& q, bool walls);
   /// Whether the edge p q lies in face f within the weld tolerance (ends on its plane, midpoint on it).
   bool edge_on_face(std::uint32_t f, const V3& p, const V3& q) const;
 

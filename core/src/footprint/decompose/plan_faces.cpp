@@ -211,6 +211,7 @@ bool Decomposer::close_in_plan(std::vector<Polygon>& out) {
     for (Ring& h : f.holes)
       for (Point2& q : h) q = Point2{q.x + o_.x, q.y + o_.y};
   }
+  // The union engine unites the faces and sorts out rings that touch or cross themselves.
   if (!unite_polygons(building, p_.min_loop_area_m2) || building.empty()) return false;
   out = std::move(building);
   stats_->closed_in_plan = true;
