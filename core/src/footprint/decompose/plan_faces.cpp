@@ -4,7 +4,7 @@
 //
 // SketchUp / Google Earth models are parts laid side by side that neither share edges nor meet exactly:
 // Macky (kml-collada-macky-google) is a hall and a front block whose lower boundaries end 7 to 8 cm
-// apart in plan and at different heights (the ground steps down the front), some of its parts turned
+// apart in plan and at different heights (the site falls 3.2 m to the back), some of its parts turned
 // inside out (their open meshes give no volume to orient them by). The walls' lower boundary then
 // closes no loop in 3D nor in plan at the weld tolerance, though in plan it is plainly the outline of
 // the building. Here every lower-boundary edge is taken in plan, ends within kPlanGap_m of each other
