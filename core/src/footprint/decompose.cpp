@@ -6,7 +6,8 @@
 // tables are not even cleared: their slots carry a generation number, see GenTable):
 // The stages, in order, each in its own file under decompose/ (see decompose/decomposer.h):
 //  1. weld.cpp, 2. topology.cpp and t_junctions.cpp, 3. orientation.cpp, 4. classification.cpp,
-//  5. lower_boundary.cpp, 6. loops.cpp, 7. polygons.cpp, 8. shadow.cpp. This file runs them.
+//  4b. contacts.cpp, 5. lower_boundary.cpp, 6. loops.cpp, 7. polygons.cpp, 7b. unite.cpp, 7c. plan_faces.cpp
+//  (when the loops miss: the lower boundary closed in plan), 8. shadow.cpp (last resort). This file runs them.
 #include "footprint/decompose.h"
 
 #include "footprint/decompose/decomposer.h"
@@ -41,7 +42,7 @@ DecomposeResult Decomposer::run(SurfaceDecomposition* dec) {
   make_polygons(res.polygons);
   if (p_.shadow_fallback && (res.polygons.empty() || open_outside_loops())) {
     res.polygons.clear();
-    make_shadow(res.polygons);
+    if (!close_in_plan(res.polygons)) make_shadow(res.polygons);
   } else {
     unite_loops(res.polygons);
   }

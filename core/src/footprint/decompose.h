@@ -78,6 +78,10 @@ struct DecomposeStats {
   bool united = false;                    // the loops overlapped and were united into one footprint
   double lower_boundary_m = 0;           // plan length of the footprint edges (set when chains stay open)
   double open_outside_m = 0;              // of which in open chains outside every loop, no higher than them
+  bool closed_in_plan = false;            // the loops missed; the lower boundary closed in plan instead
+  double plan_kept_m = 0;                 // of the lower boundary, plan length left once dangling chains went
+  double plan_gap_m = 0;                  // ends this close in plan were joined
+  double plan_pruned_outside_m = 0;       // pruned (dangling) lower boundary outside the faces closed in plan
   bool shadow = false;                    // the polygons are the shadow (shadow_fallback), not loops
 };
 

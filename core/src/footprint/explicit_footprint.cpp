@@ -115,6 +115,15 @@ bool decompose_into(const Mesh& mesh, const FootprintParams& params, FootprintRe
                       "that do not close, outside the %zu loops and no higher (a model that is not watertight)",
                       d.stats.open_outside_m, d.stats.lower_boundary_m, d.stats.open_chains, d.stats.loops);
       res.note = buf;
+    } else if (d.stats.closed_in_plan) {
+      // Issue 21: the walls' footprint, though their lower boundary closed only in plan across gaps.
+      char buf[400];
+      std::snprintf(buf, sizeof buf,
+                    "footprint closed in plan, not the shadow: the walls' lower boundary (%.1f m) leaves %zu chains "
+                    "open beside %zu loops; joined in plan where their ends lie within %.2f m, %.1f m of it enclose "
+                    "the footprint",
+                    d.stats.lower_boundary_m, d.stats.open_chains, d.stats.loops, d.stats.plan_gap_m, d.stats.plan_kept_m);
+      res.note = buf;
     }
     return true;
   }

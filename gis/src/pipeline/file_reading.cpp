@@ -254,7 +254,9 @@ void append(Part& part, const std::string& file, FileRead& out, Delivered& deliv
     FootprintResult& fp = slot.fp;
     if (fp.ok) {
       if (!fp.note.empty())  // kept, but found by a last resort: say why the earlier methods failed
-        out.problems.push_back({fp.footprint.source_id, file, "footprint", "FOOTPRINT_SHADOW", fp.note});
+        out.problems.push_back({fp.footprint.source_id, file, "footprint",
+                                fp.method == FootprintMethod::DecompositionShadow ? "FOOTPRINT_SHADOW" : "FOOTPRINT_CLOSED_IN_PLAN",
+                                fp.note});
       fp.footprint.source_file = file;
       fp.footprint.method = to_string(fp.method);
       out.footprints.push_back(std::move(fp.footprint));

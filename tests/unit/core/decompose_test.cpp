@@ -341,6 +341,21 @@ TEST(DecomposeFootprint, UpperStoreyWiderOnEverySide) {
   }
 }
 
+TEST(DecomposeFootprint, PartOnHigherGroundBesideATallerOneKeepsItsFootprint) {
+  // Two closed parts side by side (issue 21, contacts.cpp rule c): B stands 0.5 m higher than A and
+  // rises 7.5 m, so its floor's west edge lies in A's east wall, which goes on below it. That is how a
+  // balcony slab leans on a wall too, but B stands lower above A's bottom than it is tall: its floor
+  // is ground and the footprint is both parts. A slab 0.2 m thick at the same place hangs.
+  for (const double top : {8.0, 0.7}) {
+    Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 10, true, true);
+    append(m, prism(rect(10, 2, 14, 8), {}, flat(0.5), top, true, true));
+    const DecomposeResult r = decompose_footprint(m);
+    const Check c = compare(r, top > 1 ? "POLYGON((0 0,10 0,10 2,14 2,14 8,10 8,10 10,0 10,0 0))" : kSquare);
+    EXPECT_LT(c.symdiff, kEps) << "top " << top << ": area " << c.area;
+    EXPECT_FALSE(r.stats.shadow) << top;
+  }
+}
+
 TEST(DecomposeFootprint, DisconnectedParts) {
   Mesh m = prism(rect(0, 0, 10, 10), {}, flat(0), 6, true, true);
   append(m, prism(rect(30, 0, 40, 5), {}, flat(12), 20, false, true));
@@ -509,9 +524,10 @@ Mesh gappy_box(double x0, double y0, double size, double gap) {
 }
 
 TEST(DecomposeFootprint, LowerBoundaryWithGapsFallsBackToTheShadow) {
-  // Rule 3. The walls' bottoms are four open chains, 5 cm apart at the corners: no loop. The
-  // footprint is the shadow: the roof's square.
-  const Mesh m = gappy_box(0, 0, 10, 0.05);
+  // Rule 3. The walls' bottoms are four open chains, 30 cm apart at the corners: no loop, in 3D or in
+  // plan (stage 7c joins ends within 10 cm). The footprint is the shadow: the roof's square.
+  // (The gaps were 5 cm until stage 7c: those close in plan now, below.)
+  const Mesh m = gappy_box(0, 0, 10, 0.3);
   const DecomposeResult r = decompose_footprint(m);
   const Check c = compare(r, kSquare);
   EXPECT_TRUE(r.stats.shadow);
@@ -531,6 +547,37 @@ TEST(DecomposeFootprint, LowerBoundaryWithGapsFallsBackToTheShadow) {
   const DecomposeResult s = decompose_footprint(with_shed);
   EXPECT_TRUE(s.stats.shadow);
   EXPECT_LT(compare(s, kSquare, {"POLYGON((20 0,22 0,22 2,20 2,20 0))"}).symdiff, kEps);
+  // Stage 7c: 5 cm gaps (ends 7 cm apart) close in plan at the corners the walls' lines meet in: the
+  // walls' square, exactly, not the shadow; with the shed, both.
+  Mesh near = gappy_box(0, 0, 10, 0.05);
+  const DecomposeResult n = decompose_footprint(near);
+  EXPECT_FALSE(n.stats.shadow);
+  EXPECT_TRUE(n.stats.closed_in_plan);
+  EXPECT_LT(compare(n, kSquare).symdiff, kEps);
+  append(near, prism(rect(20, 0, 22, 2), {}, flat(0), 3, true, true));
+  const DecomposeResult ns = decompose_footprint(near);
+  EXPECT_TRUE(ns.stats.closed_in_plan);
+  EXPECT_LT(compare(ns, kSquare, {"POLYGON((20 0,22 0,22 2,20 2,20 0))"}).symdiff, kEps);
+}
+
+TEST(DecomposeFootprint, CourtyardClosedInPlanKeepsItsHole) {
+  // Stage 7c: a courtyard building whose outer and inner walls all stop 5 cm short of the corners.
+  // The inner ring's face is open ground (its walls face into it): a hole, not building.
+  Mesh m;
+  auto gappy_ring = [&](const Ring2& o) {
+    for (std::size_t i = 0; i < o.size(); ++i) {
+      const Point2 &a = o[i], &b = o[(i + 1) % o.size()];
+      const double len = std::hypot(b.x - a.x, b.y - a.y);
+      m.add_face({wall(a, b, {{0.05, 0}, {len - 0.05, 0}}, 9)}, SurfaceKind::Unknown, 255);
+    }
+  };
+  gappy_ring(rect(0, 0, 20, 20));
+  gappy_ring({{6, 6}, {6, 14}, {14, 14}, {14, 6}});  // clockwise: the walls face the courtyard
+  const DecomposeResult r = decompose_footprint(m);
+  EXPECT_TRUE(r.stats.closed_in_plan);
+  const Check c = compare(r, kCourtyard);
+  EXPECT_EQ(c.holes, 1u);
+  EXPECT_LT(c.symdiff, kEps);
 }
 
 TEST(DecomposeFootprint, OpenChainsInsideTheLoopsKeepTheLoops) {

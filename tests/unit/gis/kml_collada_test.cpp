@@ -273,12 +273,19 @@ TEST(KmlRealData, PipelineEndToEndOnKmzAndKmlFolders) {
   EXPECT_EQ(r.crs_name, "EPSG:32613");
   EXPECT_FALSE(r.crs_wkt.empty());
   std::size_t footprint_problems = 0;
-  // A kept shadow footprint comes with a FOOTPRINT_SHADOW note (issue 21), which drops nothing.
+  // A kept shadow footprint comes with a FOOTPRINT_SHADOW note (issue 21), one closed in plan with a
+  // FOOTPRINT_CLOSED_IN_PLAN note; neither drops anything.
   for (const Problem& p : r.problems)
-    footprint_problems += p.stage == "footprint" && p.source_id == "model_4" && p.code != "FOOTPRINT_SHADOW";
+    footprint_problems += p.stage == "footprint" && p.source_id == "model_4" && p.code != "FOOTPRINT_SHADOW" &&
+                          p.code != "FOOTPRINT_CLOSED_IN_PLAN";
   EXPECT_EQ(r.footprints.size() + footprint_problems, 1u) << problems();
   EXPECT_EQ(count("FOOTPRINT_SHADOW"), r.footprints.size() == 1 && r.footprints[0].method == "decomposition-shadow" ? 1u : 0u)
       << problems();
+  // Issue 21: Macky's walls give its footprint (their lower boundary closed in plan across the 7-8 cm
+  // gaps between its SketchUp parts), not the shadow.
+  ASSERT_EQ(r.footprints.size(), 1u) << problems();
+  EXPECT_EQ(r.footprints[0].method, "decomposition") << problems();
+  EXPECT_EQ(count("FOOTPRINT_CLOSED_IN_PLAN"), 1u) << problems();
 
   options.inputs = {shared("kml-collada-korea-mago/sample-kml")};
   r = run_pipeline(options);

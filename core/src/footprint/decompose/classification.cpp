@@ -20,12 +20,15 @@ void Decomposer::classify() {
 
 /// Floor patches from whose boundary a wall goes down are soffits (the underside of an upper
 /// storey wider than the one below), not ground: walls rising from them are no footprint, or a
-/// storey overhanging on every side would give its shadow. hanging[f] for floor facets.
+/// storey overhanging on every side would give its shadow. Unless the patch reaches out much further
+/// than the walls drop (kStepDepthPerDrop): then it is the ground's upper step on a slope and the wall
+/// going down is the riser (step_floor). hanging[f] and step_floor[f] for floor facets.
 void Decomposer::find_hanging_floors() {
   const std::size_t nf = ws_.faces.size();
   auto& par = ws_.floor_uf;
   par.resize(nf);
   ws_.hanging.assign(nf, 0);
+  ws_.step_floor.assign(nf, 0);
   bool any = false;
   for (std::uint32_t f = 0; f < nf; ++f) {
     par[f] = f;
@@ -37,29 +40,58 @@ void Decomposer::find_hanging_floors() {
     return x;
   };
   const std::size_t ng = ws_.group_count.size();
+  bool any_down = false;
   for (int pass = 0; pass < 2; ++pass)
     for (std::size_t g = 0; g < ng; ++g) {
       const std::uint32_t s = ws_.group_start[g], c = ws_.group_count[g];
       std::uint32_t first_floor = kNone;
       bool down = false;
+      double wall_lo = std::numeric_limits<double>::infinity();  // lowest z of the walls going down
       for (std::uint32_t i = 0; i < c; ++i) {
         const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
         const std::uint8_t cls = ws_.faces[h.face].cls;
-        if (cls == kWall && h.up < 0) down = true;
+        if (cls == kWall && h.up < 0) down = true, wall_lo = std::min(wall_lo, ws_.faces[h.face].lo.z);
         if (cls != kFloor) continue;
         if (pass == 0) {
           if (first_floor == kNone) first_floor = h.face;
           else par[find(h.face)] = find(first_floor);
         }
       }
-      if (pass == 1 && down)
-        for (std::uint32_t i = 0; i < c; ++i) {
-          const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
-          if (ws_.faces[h.face].cls == kFloor) ws_.hanging[find(h.face)] = 1;
+      if (pass == 0 || !down) continue;
+      const HalfEdge& h0 = ws_.halfedges[ws_.group_members[s]];
+      const V3 &a = ws_.wpos[h0.a], &b = ws_.wpos[h0.b];
+      for (std::uint32_t i = 0; i < c; ++i) {
+        const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
+        if (ws_.faces[h.face].cls != kFloor) continue;
+        const std::uint32_t r = find(h.face);
+        if (!any_down) {
+          any_down = true;
+          ws_.patch_down_len.assign(nf, 0);
+          ws_.patch_drop.assign(nf, 0);
         }
+        ws_.hanging[r] = 1;
+        ws_.patch_down_len[r] += std::hypot(b.x - a.x, b.y - a.y);
+        ws_.patch_drop[r] = std::max(ws_.patch_drop[r], std::min(a.z, b.z) - wall_lo);
+        break;  // one floor facet per edge: the patch's edge counted once
+      }
     }
+  if (any_down) {
+    // Plan area of each hanging patch, then soffit or step.
+    auto& area = ws_.patch_plan_area;
+    area.assign(nf, 0);
+    for (std::uint32_t f = 0; f < nf; ++f)
+      if (ws_.faces[f].cls == kFloor) area[find(f)] += std::fabs(ws_.faces[f].net.z) / 2;  // holes less
+    for (std::uint32_t f = 0; f < nf; ++f)
+      if (ws_.faces[f].cls == kFloor && par[f] == f && ws_.hanging[f] &&
+          area[f] > kStepDepthPerDrop * ws_.patch_drop[f] * ws_.patch_down_len[f])
+        ws_.hanging[f] = 0, ws_.step_floor[f] = 1;
+  }
   for (std::uint32_t f = 0; f < nf; ++f)
-    if (ws_.faces[f].cls == kFloor) ws_.hanging[f] = ws_.hanging[find(f)];
+    if (ws_.faces[f].cls == kFloor) {
+      const std::uint32_t r = find(f);
+      ws_.hanging[f] = ws_.hanging[r];
+      ws_.step_floor[f] = ws_.step_floor[r];
+    }
 }
 
 void Decomposer::fill_decomposition(SurfaceDecomposition& dec) {

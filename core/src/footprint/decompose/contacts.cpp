@@ -13,15 +13,18 @@
 //      soffit (a slab roof on walls, a box set on a lower one that it overhangs);
 //  (b) a lower-boundary edge of the walls on a ceiling facet: the walls stand on a roof (a box set
 //      on another), a ceiling boundary as in the paper, so no footprint edge.
-// Not done: a floor facet's edge on a wall facet that goes on below it (a balcony slab against a
-// wall) does not make the floor hang, because a building part on slightly higher ground beside a
-// taller one looks the same (Berlin LoD2 sample: two buildings lost half their footprint).
+//  (c) a floor facet's edge on a wall facet that goes on below it (a balcony slab against a wall):
+//      the floor hangs when it lies higher above the bottom of the part it leans on than its own part
+//      reaches above it. A building part on slightly higher ground beside a taller one looks the same
+//      but for the heights: it stands 0.5 m up and rises 8 m (Berlin LoD2 sample), where a balcony
+//      slab stands 3 m up and is 0.2 m thick.
 // Only between different parts (components): one part's own faces already share their edges.
 // Holes of the touched face are not looked at (an edge over a hole counts as on the face).
 #include "footprint/decompose/decomposer.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace groundplan::footprint::detail {
 
@@ -44,6 +47,71 @@ void Decomposer::project_faces() {
     }
   }
   start[nf] = static_cast<std::uint32_t>(pts.size());
+}
+
+void Decomposer::index_faces() {
+  auto& G = ws_.grid;
+  const std::size_t nf = ws_.faces.size();
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  std::size_t used = 0;
+  auto usable = [&](const FaceInfo& fi) { return fi.cls != kSkipped && fi.len > 0; };
+  for (const FaceInfo& fi : ws_.faces)
+    if (usable(fi)) x0 = std::min(x0, fi.lo.x), y0 = std::min(y0, fi.lo.y), x1 = std::max(x1, fi.hi.x), y1 = std::max(y1, fi.hi.y), ++used;
+  G.n = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(used))), 1, 64);
+  G.x0 = x0, G.y0 = y0;
+  G.sx = G.n / std::max(x1 - x0, 1e-9), G.sy = G.n / std::max(y1 - y0, 1e-9);
+  const std::size_t cells = static_cast<std::size_t>(G.n) * G.n;
+  auto cx = [&](double x) { return std::clamp(static_cast<int>((x - G.x0) * G.sx), 0, G.n - 1); };
+  auto cy = [&](double y) { return std::clamp(static_cast<int>((y - G.y0) * G.sy), 0, G.n - 1); };
+  for (int k = 0; k < 2; ++k) G.start[k].assign(cells + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::uint32_t f = 0; f < nf; ++f) {
+      const FaceInfo& fi = ws_.faces[f];
+      if (!usable(fi)) continue;
+      const int k = fi.cls == kWall;
+      auto& start = G.start[k];
+      for (int j = cy(fi.lo.y), j1 = cy(fi.hi.y); j <= j1; ++j)
+        for (int i = cx(fi.lo.x), i1 = cx(fi.hi.x); i <= i1; ++i) {
+          const std::size_t c = static_cast<std::size_t>(j) * G.n + i;
+          if (pass == 0) ++start[c + 1];
+          else G.faces[k][start[c]++] = f;  // start[c] used as the cursor, restored below
+        }
+    }
+    for (int k = 0; k < 2; ++k) {
+      auto& start = G.start[k];
+      if (pass == 0) {
+        for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+        G.faces[k].resize(start[cells]);
+      } else {
+        for (std::size_t c = cells; c > 0; --c) start[c] = start[c - 1];
+        start[0] = 0;
+      }
+    }
+  }
+  G.stamp.assign(nf, 0);
+  G.gen = 0;
+}
+
+void Decomposer::faces_near(const V3& p, const V3& q, bool walls) {
+  auto& G = ws_.grid;
+  G.near.clear();
+  ++G.gen;
+  auto cx = [&](double x) { return std::clamp(static_cast<int>((x - G.x0) * G.sx), 0, G.n - 1); };
+  auto cy = [&](double y) { return std::clamp(static_cast<int>((y - G.y0) * G.sy), 0, G.n - 1); };
+  const int i0 = cx(std::min(p.x, q.x) - tol_), i1 = cx(std::max(p.x, q.x) + tol_);
+  const int j0 = cy(std::min(p.y, q.y) - tol_), j1 = cy(std::max(p.y, q.y) + tol_);
+  for (int k = 0; k <= int(walls); ++k)
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t c = static_cast<std::size_t>(j) * G.n + i;
+        for (std::uint32_t e = G.start[k][c]; e < G.start[k][c + 1]; ++e) {
+          const std::uint32_t f = G.faces[k][e];
+          if (G.stamp[f] != G.gen) G.stamp[f] = G.gen, G.near.push_back(f);
+        }
+      }
+  // Rule c stops at the first wall it finds and rule b at the first ceiling: when both may apply,
+  // the face of smaller index decides, as it did when every face was tried in order.
+  if (walls) std::sort(G.near.begin(), G.near.end());
 }
 
 bool Decomposer::edge_on_face(std::uint32_t f, const V3& p, const V3& q) const {
@@ -81,6 +149,7 @@ void Decomposer::find_contacts() {
   for (const FaceInfo& fi : ws_.faces) any_floor |= fi.cls == kFloor, any_ceiling |= fi.cls == kCeiling;
   if (!any_floor && !any_ceiling) return;
   project_faces();
+  index_faces();
   const std::size_t nf = ws_.faces.size(), ng = ws_.group_count.size();
   auto& par = ws_.floor_uf;
   auto root = [&](std::uint32_t x) {
@@ -107,8 +176,11 @@ void Decomposer::find_contacts() {
     const std::uint32_t comp = ws_.face_comp[any];
     const bool rule_a = wall_down && !floor;
     const bool rule_b = wall_up && !wall_down && !ceiling && !floor_hanging;
-    if (!rule_a && !rule_b) continue;
-    for (std::uint32_t f = 0; f < nf; ++f) {
+    const bool rule_c = floor && !floor_hanging && !wall_down;
+    if (!rule_a && !rule_b && !rule_c) continue;
+    const double z_edge = std::min(p.z, q.z);
+    faces_near(p, q, rule_c);  // the faces whose box could hold the edge
+    for (const std::uint32_t f : ws_.grid.near) {
       const FaceInfo& fi = ws_.faces[f];
       if (ws_.face_comp[f] == comp) continue;
       if (rule_a && fi.cls == kFloor && !ws_.hanging[f] && edge_on_face(f, p, q)) {
@@ -116,6 +188,16 @@ void Decomposer::find_contacts() {
         ++stats_->contacts;
       } else if (rule_b && fi.cls == kCeiling && edge_on_face(f, p, q)) {
         ws_.on_roof[g] = 1;
+        ++stats_->contacts;
+        break;
+      } else if (rule_c && fi.cls == kWall && fi.lo.z < z_edge - tol_ &&
+                 z_edge - ws_.comp_lo[ws_.face_comp[f]].z > ws_.comp_hi[comp].z - std::max(p.z, q.z) &&
+                 edge_on_face(f, p, q)) {
+        for (std::uint32_t i = 0; i < c; ++i) {
+          const HalfEdge& h = ws_.halfedges[ws_.group_members[s + i]];
+          if (ws_.faces[h.face].cls == kFloor) ws_.hanging[root(h.face)] = 1, ws_.hanging[h.face] = 1;
+        }
+        hung = true;
         ++stats_->contacts;
         break;
       }

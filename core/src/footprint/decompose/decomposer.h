@@ -11,6 +11,8 @@
 //   lower_boundary.cpp  5. footprint edges: lower boundary of the walls, local minima
 //   loops.cpp           6. footprint edges chained into loops (3D, then in plan view)
 //   polygons.cpp        7. loops to polygons with holes
+//   unite.cpp           7b. one footprint's polygons united
+//   plan_faces.cpp      7c. when the loops miss: the lower boundary closed in plan
 //   shadow.cpp          8. the shadow, when the loops miss where the building stands
 // The per-vertex helpers of the weld, called from the ring pass in topology.cpp, stay inline here.
 #include "footprint/decompose.h"
@@ -28,6 +30,15 @@ constexpr std::uint32_t kBad = kNone - 1;  // a vertex with NaN or infinite coor
 /// A wall facet "rises" from an edge when the in-plane direction into it has at least this z
 /// component (unit vectors): vertical edges (0) and edges of walls leaning < 0.6° are neither.
 constexpr double kRise = 0.01;
+/// A floor patch from whose edges walls go down is a soffit (it hangs) when its mean depth beyond those
+/// edges (plan area / their plan length) is at most this many times the walls' drop below it; deeper,
+/// it is a step of the ground (a building on a slope, its floor following the terrain). A cantilever
+/// reaches out about as far as it stands high (stepped_ground in tests/support/known_footprints.cpp:
+/// 10 m deep over a 2 m riser; cantilever: 2 m over 3 m; boxed eaves: 0.9 m over 3 m).
+constexpr double kStepDepthPerDrop = 2;
+/// Stage 7c (plan_faces.cpp): lower-boundary ends this close in plan are one point when the loops
+/// failed (SketchUp parts ending 7 to 8 cm apart: Macky). Metres.
+constexpr double kPlanGap_m = 0.1;
 
 struct V3 {
   double x = 0, y = 0, z = 0;
@@ -183,9 +194,24 @@ struct Workspace {
   std::vector<std::int32_t> poly_of_loop;
   std::vector<std::uint32_t> floor_uf;
   std::vector<std::uint8_t> hanging;
+  /// Floor facets of a patch from whose edge a wall goes down but too little for its depth to be a
+  /// soffit: a step of the ground under a building on a slope (classification.cpp); the wall going
+  /// down is the riser, and the patch's edge on it bounds the footprint (lower_boundary.cpp).
+  std::vector<std::uint8_t> step_floor;
+  std::vector<double> patch_plan_area, patch_down_len, patch_drop;  // per floor patch root, while hanging
   std::vector<std::uint32_t> face_pts_start;  // contacts.cpp: each face's outer ring, projected along its normal
   std::vector<Point2> face_pts;
   std::vector<std::uint8_t> on_roof;  // per edge group: its walls stand on another part's ceiling (contacts.cpp)
+  /// contacts.cpp: the used faces bucketed by their plan boxes in an n x n grid (CSR), so that an edge
+  /// is tried against the faces near it, not all of them; floors and ceilings (rules a, b) apart from
+  /// walls (rule c), which are most faces and asked for least.
+  struct FaceGrid {
+    int n = 1;
+    double x0 = 0, y0 = 0, sx = 1, sy = 1;  // cell of x: (x - x0) * sx, clamped
+    std::vector<std::uint32_t> start[2], faces[2];  // [0] floors and ceilings, [1] walls
+    std::vector<std::uint32_t> stamp, near;
+    std::uint32_t gen = 0;
+  } grid;
 };
 
 /// Half-edge h, of the undirected edge lo < hi, into its group (groups numbered in order of first
@@ -439,6 +465,11 @@ class Decomposer {
   void find_contacts();
   /// Each used face's outer ring projected along its normal's largest component (face_pts).
   void project_faces();
+  /// ws_.grid over the used faces' plan boxes.
+  void index_faces();
+  /// The used faces (floors and ceilings, and walls when `walls`) whose plan box meets the edge p q's
+  /// widened by tol: ws_.grid.near, in increasing order when `walls`.
+  void faces_near(const V3& p, const V3& q, bool walls);
   /// Whether the edge p q lies in face f within the weld tolerance (ends on its plane, midpoint on it).
   bool edge_on_face(std::uint32_t f, const V3& p, const V3& q) const;
 
@@ -483,6 +514,12 @@ class Decomposer {
   /// building stands. Open chains inside a loop (a part standing on another) or above every loop
   /// (a balcony, a canopy: floating slabs are local minima too, but not ground) do not count.
   bool open_outside_loops() const;
+
+  // ---- 7c. the lower boundary closed in plan, before the shadow (plan_faces.cpp) ------------------
+  /// Every lower-boundary edge in plan, undirected, ends within kPlanGap_m one point, dangling chains
+  /// pruned; the union of the bounded faces into `out`. False (out untouched) when over a tenth of
+  /// the lower boundary was pruned outside those faces, or no face closed.
+  bool close_in_plan(std::vector<Polygon>& out);
 
   // ---- 8. the shadow: last resort (shadow.cpp) ------------------------------------------------------
   /// Rule 3: the loops miss where the building stands (a mesh full of gaps, walls

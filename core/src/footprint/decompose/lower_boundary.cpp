@@ -7,7 +7,8 @@
 //     Not where a ceiling meets it (paper: "except the ceiling boundaries": parapets, penthouses),
 //     nor a floor patch from which a wall goes down elsewhere (a soffit: an upper storey wider than
 //     the one below on every side would otherwise give its shadow). Edges of two wall facets that
-//     rise from it on opposite sides (parts sharing a wall) cancel.
+//     rise from it on opposite sides (parts sharing a wall) cancel. Where the ground steps (a floor
+//     that follows a slope, classification.cpp), the riser's top edge bounds the upper step.
 #include "footprint/decompose/decomposer.h"
 
 #include <algorithm>
@@ -27,11 +28,12 @@ void Decomposer::collect_footprint_edges() {
   const HalfEdge* H = ws_.halfedges.data();
   const FaceInfo* F = ws_.faces.data();
   const std::uint8_t* hanging = ws_.hanging.data();
+  const std::uint8_t* step = ws_.step_floor.data();
   for (std::size_t g = 0; g < ng; ++g) {
     if (ws_.on_roof[g]) continue;  // stands on another part's roof (contacts.cpp)
     const std::uint32_t s = st[g], c = cnt[g];
-    int net = 0;
-    bool below = false;
+    int net = 0, net_down = 0;
+    bool below = false, down = false, on_step = false;
     std::uint32_t comp = kNone, lo = 0, hi = 0;
     for (std::uint32_t i = 0; i < c; ++i) {
       const HalfEdge& h = H[mem[s + i]];
@@ -43,20 +45,26 @@ void Decomposer::collect_footprint_edges() {
         below = true;
         break;
       }
-      if (fi.cls != kWall) continue;
-      if (h.up < 0) {
-        below = true;
-        break;
-      }
-      if (h.up == 0) continue;
+      if (fi.cls == kFloor) on_step |= step[h.face] != 0;
+      if (fi.cls != kWall || h.up == 0) continue;
       // Outward orientation: the building lies left of the edge seen from above.
       const std::uint32_t from = fi.sign > 0 ? h.a : h.b;
       lo = std::min(h.a, h.b);
       hi = std::max(h.a, h.b);
-      net += from == lo ? 1 : -1;
       if (comp == kNone) comp = comp_of(h.face);
+      if (h.up < 0) {
+        // A wall going down: no local minimum, unless it is the riser below a step of the ground
+        // (classification.cpp), whose top edge bounds the upper step. Seen from above, the wall's
+        // top edge runs against its bottom edge, so the upper step (outside the riser) lies left.
+        down = true;
+        net_down += from == lo ? 1 : -1;
+        continue;
+      }
+      net += from == lo ? 1 : -1;
     }
-    if (below || net == 0) continue;
+    if (below || (down && !on_step)) continue;
+    net += net_down;
+    if (net == 0) continue;
     for (int k = 0; k < std::abs(net); ++k) cand.push_back(net > 0 ? DirEdge{lo, hi, comp} : DirEdge{hi, lo, comp});
   }
   stats_->footprint_edges = cand.size();
