@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 
 #include "robust/predicates.h"
@@ -37,7 +38,22 @@ std::string where(const Point2& p) {
 
 }  // namespace
 
-NearTouch near_touch(const std::vector<GroundPlan>& plans, double ulps) {
+NearTouch near_touch(const std::vector<GroundPlan>& plans, double ulps, const std::vector<Footprint>* input) {
+  auto less = [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); };
+  std::vector<Point2> in;  // the input vertices, sorted, for "did the union compute this point?"
+  if (input)
+    for (const Footprint& f : *input)
+      for (const Polygon& poly : f.polygons) {
+        in.insert(in.end(), poly.outer.begin(), poly.outer.end());
+        for (const Ring& h : poly.holes) in.insert(in.end(), h.begin(), h.end());
+      }
+  std::sort(in.begin(), in.end(), less);
+  auto computed = [&](std::initializer_list<Point2> pts) {
+    if (!input) return false;
+    for (const Point2& p : pts)
+      if (!std::binary_search(in.begin(), in.end(), p, less)) return true;
+    return false;
+  };
   std::vector<Point2> pts;
   std::vector<Seg> segs;
   for (const GroundPlan& g : plans) {
@@ -51,12 +67,13 @@ NearTouch near_touch(const std::vector<GroundPlan>& plans, double ulps) {
     for (const Ring& h : g.polygon.holes) ring(h);
   }
   NearTouch out;
-  auto found = [&](const std::string& what) {
+  auto found = [&](const std::string& what, bool by_union) {
     if (out.pairs++ == 0) out.first = what;
+    if (by_union && out.computed++ == 0) out.first_computed = what;
   };
   auto tol = [&](double m) { return ulps * ulp_at(m); };
   // vertex-vertex: sweep by x
-  std::sort(pts.begin(), pts.end(), [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  std::sort(pts.begin(), pts.end(), less);
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   for (std::size_t i = 0; i < pts.size(); ++i)
     for (std::size_t j = i + 1; j < pts.size(); ++j) {
@@ -65,7 +82,8 @@ NearTouch near_touch(const std::vector<GroundPlan>& plans, double ulps) {
       if (pts[j].x - pts[i].x > t) break;
       if (std::fabs(pts[j].y - pts[i].y) <= t)
         found("vertices " + where(pts[i]) + " and " + where(pts[j]) + " are distinct but within " +
-              std::to_string(ulps) + " ulps");
+              std::to_string(ulps) + " ulps",
+              computed({pts[i], pts[j]}));
     }
   // vertex-edge: edges sorted by their smaller x; a vertex looks at edges starting up to the longest
   // edge's x extent to its left
@@ -86,7 +104,8 @@ NearTouch near_touch(const std::vector<GroundPlan>& plans, double ulps) {
       const double mm = std::max({m, std::fabs(s.a.x), std::fabs(s.a.y), std::fabs(s.b.x), std::fabs(s.b.y)});
       if (interior_dist(p, s) <= tol(mm))
         found("vertex " + where(p) + " is within " + std::to_string(ulps) + " ulps of edge " + where(s.a) + "-" +
-              where(s.b) + " but not on it");
+              where(s.b) + " but not on it",
+              computed({p, s.a, s.b}));
     }
   }
   return out;

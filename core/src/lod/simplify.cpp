@@ -104,9 +104,13 @@ class CellMap {
 
  private:
   static constexpr std::uint64_t kEmpty = ~0ull;
-  // Cell indices are clamped to +-2^30 (see Grid::cell_of), so 32 bits each suffice.
+  // Cell indices are clamped to +-2^30 (Grid::clampi), so each fits 32 bits once biased by 2^31; the
+  // bias keeps both halves within [2^30, 3 * 2^30], so no cell packs to kEmpty. (Unbiased, the cell
+  // (-1, -1), down-left of the grid's origin, packed to ~0 = kEmpty: what was put there could never be
+  // found, so a shortcut there saw none of the edges it crossed: fuzz_lod's b16fa889.)
   static std::uint64_t pack(std::int64_t cx, std::int64_t cy) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cx)) << 32) | static_cast<std::uint32_t>(cy);
+    constexpr std::int64_t kBias = std::int64_t{1} << 31;
+    return (static_cast<std::uint64_t>(cx + kBias) << 32) | static_cast<std::uint64_t>(cy + kBias);
   }
   static std::size_t hash(std::uint64_t h) {
     h ^= h >> 31;

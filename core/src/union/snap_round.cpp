@@ -19,6 +19,7 @@
 #include <cstring>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 
 #include "robust/predicates.h"
 #include "union/output_rounding.h"
@@ -410,7 +411,87 @@ std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, d
   return parent;
 }
 
-bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near) {
+namespace {
+
+/// Whether a point the union computed (in `computed`, sorted by x then y) is within `pitch` of a vertex
+/// or edge of `rings` it is not on, or an edge with a computed end is within `pitch` of another vertex.
+/// Computed points are few (rounded crossings): two small grids, one of them and one of the edges that
+/// end at one, and one pass over all edges and one over all vertices.
+bool computed_near_touch(const std::vector<std::vector<Point2>>& rings, double pitch, const std::vector<Point2>& computed) {
+  auto xy = [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); };
+  std::vector<Point2> cpts;             // computed vertices
+  std::vector<Box> cpb, ceb;            // their boxes; boxes of edges with a computed end, grown by pitch
+  std::vector<std::pair<Point2, Point2>> cedges;
+  Box call, eall;
+  for (const auto& r : rings) {
+    const std::size_t n = r.size();
+    std::vector<char> comp(n);
+    for (std::size_t i = 0; i < n; ++i) comp[i] = std::binary_search(computed.begin(), computed.end(), r[i], xy);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (comp[i]) {
+        cpts.push_back(r[i]);
+        Box b;
+        b.add(r[i]);
+        cpb.push_back(b);
+        call.add(r[i]);
+      }
+      if (comp[i] || comp[(i + 1) % n]) {
+        cedges.emplace_back(r[i], r[(i + 1) % n]);
+        Box b;
+        b.add(r[i]);
+        b.add(r[(i + 1) % n]);
+        b.grow(pitch);
+        ceb.push_back(b);
+        eall.add({b.minx, b.miny});
+        eall.add({b.maxx, b.maxy});
+      }
+    }
+  }
+  if (cpts.empty()) return false;
+  const long double d = pitch;
+  bool found = false;
+  std::size_t nv = 0;
+  for (const auto& r : rings) nv += r.size();
+  if ((cpts.size() + cedges.size()) * nv <= 4096) {  // small: every pair (no grid to build)
+    for (const auto& r : rings)
+      for (std::size_t i = 0; i < r.size() && !found; ++i) {
+        const Point2& a = r[i];
+        const Point2& b = r[(i + 1) % r.size()];
+        for (const Point2& c : cpts)
+          if (!(c == a) && !(c == b) && dist_to_segment(c, a, b) <= d) found = true;
+        for (const auto& [p, q2] : cedges)
+          if (!(a == p) && !(a == q2) && dist_to_segment(a, p, q2) <= d) found = true;
+      }
+    return found;
+  }
+  BoxGrid pgrid, egrid;
+  pgrid.build(cpb, call, cpb.size());
+  egrid.build(ceb, eall, ceb.size());
+  for (const auto& r : rings)
+    for (std::size_t i = 0; i < r.size() && !found; ++i) {
+      const Point2& a = r[i];
+      const Point2& b = r[(i + 1) % r.size()];
+      Box q;  // computed vertices near this edge
+      q.add(a);
+      q.add(b);
+      q.grow(pitch);
+      pgrid.query(q, [&](std::uint32_t k) {
+        if (!found && !(cpts[k] == a) && !(cpts[k] == b) && dist_to_segment(cpts[k], a, b) <= d) found = true;
+      });
+      Box v;  // edges with a computed end near this vertex
+      v.add(a);
+      egrid.query(v, [&](std::uint32_t e) {
+        const auto& [p, q2] = cedges[e];
+        if (!found && !(a == p) && !(a == q2) && dist_to_segment(a, p, q2) <= d) found = true;
+      });
+    }
+  return found;
+}
+
+}  // namespace
+
+bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near,
+                      const std::vector<Point2>* computed) {
   {
     std::vector<std::vector<Point2>*> rr;
     for (const auto& r : rings) rr.push_back(const_cast<std::vector<Point2>*>(&r));
@@ -421,6 +502,7 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
     if (touch_cycle(rr)) return false;
   }
   if (!near) return true;
+  if (computed) return !computed_near_touch(rings, pitch, *computed);
   std::vector<Point2> pts;
   std::vector<Box> pb;
   Box all;
@@ -453,7 +535,7 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
 }
 
 bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded,
-                        double pitch, bool near) {
+                        double pitch, bool near, const std::vector<Point2>* computed) {
   // only rings that can meet a rounded one: the others are exact and pairwise fine
   std::vector<Box> rb;
   Box all;
@@ -477,7 +559,7 @@ bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std
       grid.query(box[i], [&](std::uint32_t k) { take = take || box[i].overlaps(rb[k]); });
     if (take) sel.push_back(rings[i]);
   }
-  return clean_as_rounded(sel, pitch, near);
+  return clean_as_rounded(sel, pitch, near, computed);
 }
 
 double snap_pitch(double max_abs) {

@@ -293,6 +293,29 @@ TEST(LodSimplify, ARingKeepsAtLeastThreeVerticesAndItsOrientation) {
   EXPECT_EQ(validity_problem(out2), "");
 }
 
+TEST(LodSimplify, AShortcutDownLeftOfTheFirstVertexSeesTheEdgeItWouldCross) {
+  // fuzz_lod's b16fa889 (tests/corpus/fuzz-regressions/lod/): the plan that --snap 0.3 and
+  // --close-gaps 2.5 made of it, simplified with T = 2.5. The edge index's cells are counted from the
+  // first vertex (the top right here); the shortcut (0, 11/7) -> (96/7, 0) lies in the cell down-left
+  // of it, cell (-1, -1), which the index packed to its empty-slot key, so the edge (4.79, 0.55) ->
+  // (255/7, 50/7) there was never found and the shortcut crossed it: a self-intersecting plan.
+  const Ring ring{{35, 35.142857142857146},
+                  {0.8571428571428571, 1.4285714285714286},
+                  {0, 1.5714285714285714},
+                  {0.42857142857142855, 0.7142857142857143},
+                  {0.8571428571428571, 0},
+                  {13.714285714285714, 0},
+                  {4.7877551020408164, 0.55102040816326525},
+                  {36.428571428571431, 7.1428571428571432}};
+  const std::vector<GroundPlan> in{plan(ring)};
+  ASSERT_EQ(validity_problem(in), "");
+  const auto out = simplify_plans(in, 2.5);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(validity_problem(out), "");
+  EXPECT_LE(hausdorff(ring, out[0].polygon.outer), 2.5 + 1e-9);
+  EXPECT_LT(out[0].polygon.outer.size(), ring.size());  // it does simplify: (0.86, 1.43) goes
+}
+
 TEST(LodSimplify, RejectsANonPositiveOrNonFiniteTolerance) {
   const std::vector<GroundPlan> in{plan({{0, 0}, {1, 0}, {1, 1}, {0, 1}})};
   EXPECT_THROW(simplify_plans(in, 0), InvalidArgument);

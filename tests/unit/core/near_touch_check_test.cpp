@@ -43,5 +43,39 @@ TEST(NearTouchCheck, VertexWithinRoundingOfAnotherEdge) {
   EXPECT_NE(nt.first.find("but not on it"), std::string::npos) << nt.first;
 }
 
+TEST(NearTouchCheck, TellsPairsTheUnionComputedFromPairsOfInputVertices) {
+  // A triangle's vertex one ulp off the square's edge x = 0: as input, both plans are footprints, so the
+  // pair is the input's own (an inexact rotation does this to a T-junction), not an artefact of the union.
+  const double y = std::nextafter(0.5, 1.0);
+  const Ring square{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const Ring triangle{{-1, 0.25}, {-1e-17, y}, {-1, 0.75}};
+  const std::vector<GroundPlan> plans{plan(square), plan(triangle)};
+  const std::vector<Footprint> input{Footprint{{Polygon{square, {}}}, {}, {}, {}, 0, 0},
+                                     Footprint{{Polygon{triangle, {}}}, {}, {}, {}, 0, 0}};
+  const auto nt = testing::near_touch(plans, 8, &input);
+  EXPECT_EQ(nt.pairs, 1u);
+  EXPECT_EQ(nt.computed, 0u) << nt.first_computed;
+  // The same plans when the triangle's tip was computed (no input vertex): an artefact.
+  const std::vector<Footprint> other_tip{input[0], Footprint{{Polygon{{{-1, 0.25}, {-1, 0.5}, {-1, 0.75}}, {}}}, {}, {}, {}, 0, 0}};
+  const auto nt2 = testing::near_touch(plans, 8, &other_tip);
+  EXPECT_EQ(nt2.pairs, 1u);
+  EXPECT_EQ(nt2.computed, 1u);
+  EXPECT_NE(nt2.first_computed.find("but not on it"), std::string::npos) << nt2.first_computed;
+  // ... or an end of the edge it nearly touches was computed.
+  const std::vector<Footprint> other_edge{Footprint{{Polygon{{{0, 0}, {1, 0}, {1, 1}, {0, 2}}, {}}}, {}, {}, {}, 0, 0},
+                                          input[1]};
+  EXPECT_EQ(testing::near_touch(plans, 8, &other_edge).computed, 1u);
+  // Two vertices a few ulps apart, one of them computed.
+  const double x = std::nextafter(std::nextafter(1.0, 2.0), 2.0);
+  const std::vector<GroundPlan> vv{plan(square), plan({{x, 1}, {2, 1}, {2, 2}, {1.5, 2}})};
+  const std::vector<Footprint> vv_input{input[0], Footprint{{Polygon{{{x, 0.5}, {2, 1}, {2, 2}, {1.5, 2}}, {}}}, {}, {}, {}, 0, 0}};
+  const auto nt3 = testing::near_touch(vv, 8, &vv_input);
+  EXPECT_EQ(nt3.pairs, 1u);
+  EXPECT_EQ(nt3.computed, 1u);
+  EXPECT_NE(nt3.first_computed.find("distinct but within"), std::string::npos) << nt3.first_computed;
+  // Without the input nothing is called computed (the count of all pairs is what the callers had).
+  EXPECT_EQ(testing::near_touch(vv).computed, 0u);
+}
+
 }  // namespace
 }  // namespace groundplan
