@@ -331,6 +331,43 @@ TEST(CityJsonReader, SequenceBadLinesAreProblemsAndLongLinesSkipped) {
   EXPECT_THROW(read(no_header.path), InputError);
 }
 
+// A feature's members are found as a lookup by key finds them (the first of a repeated key), each
+// vertex needs exactly three numbers, and a line longer than the 1 MiB read chunk is read whole.
+TEST(CityJsonReader, SequenceFeatureMembersVerticesAndLinesAcrossChunks) {
+  const std::string header =
+      R"({"type":"CityJSON","version":"2.0","transform":{"scale":[0.001,0.001,0.001],"translate":[0,0,0]},"CityObjects":{},"vertices":[]})";
+  auto feature = [](const std::string& id, const std::string& before, const std::string& vertices,
+                    const std::string& after) {
+    return R"({"type":"CityJSONFeature")" + before + R"(,"id":")" + id + R"(","CityObjects":{")" + id +
+           R"(":{"type":"Building","geometry":[{"type":"Solid","lod":"2","boundaries":[)" + kCubeShell +
+           R"(]}]}},"vertices":)" + vertices + after + "}";
+  };
+  std::string two_numbers = kCubeVertices;  // vertex 7 loses its z
+  two_numbers.replace(two_numbers.rfind(",1000]"), 6, "]");
+  const std::string big(1536 * 1024, 'x');  // the line spans two read chunks
+  const std::string text = header + "\n" + feature("a", "", kCubeVertices, R"(,"vertices":[])") + "\n" +
+                           feature("b", "", two_numbers, "") + "\n" +
+                           feature("c", R"(,"type":"Other")", kCubeVertices, "") + "\n" +
+                           feature("d", R"(,"attributes":{"note":")" + big + "\"}", kCubeVertices, "") + "\n" +
+                           feature("e", "", kCubeVertices, "") + "\n";
+  MemFile f("members.city.jsonl", text);
+  const Read r = read(f.path);
+  EXPECT_EQ(r.count("BAD_LINE"), 0u);
+  // Line 3's vertex 7 has two numbers: said once by the reader (then again for each surface on it).
+  const auto said = std::count_if(r.problems.begin(), r.problems.end(), [](const Problem& p) {
+    return p.code == "NOT_FINITE" && p.reason.find("line 3 \"vertices\": 1 vertices") != std::string::npos;
+  });
+  EXPECT_EQ(said, 1);
+  for (const char* id : {"a", "c", "d", "e"}) {
+    const Mesh* m = r.mesh(id);
+    ASSERT_TRUE(m) << id;
+    EXPECT_EQ(m->faces.size(), 6u) << id;
+  }
+  const Mesh* b = r.mesh("b");
+  EXPECT_TRUE(b == nullptr || b->faces.size() < 6u);  // faces on vertex 7 dropped
+  EXPECT_EQ(r.info.cityjson.features, 5u);
+}
+
 TEST(CityJsonReader, DetectionAndFolderNames) {
   EXPECT_EQ(gis::detect_format("x.city.json", ""), gis::InputFormat::CityJson);
   EXPECT_EQ(gis::detect_format("x.city.jsonl", ""), gis::InputFormat::CityJsonSeq);
