@@ -28,25 +28,25 @@
 
 namespace groundplan::footprint::detail {
 
-void Decomposer::project_faces() {
-  const std::size_t nf = ws_.faces.size();
-  auto& start = ws_.face_pts_start;
+const Point2* Decomposer::projected_face(std::uint32_t f, std::size_t& n) {
+  auto& at = ws_.face_pts_at;
   auto& pts = ws_.face_pts;
-  start.assign(nf + 1, 0);
-  pts.clear();
-  for (std::uint32_t f = 0; f < nf; ++f) {
-    start[f] = static_cast<std::uint32_t>(pts.size());
+  if (at[f] == kNone) {
+    at[f] = static_cast<std::uint32_t>(pts.size());
+    ws_.face_pts_n[f] = 0;
     const FaceInfo& fi = ws_.faces[f];
-    if (fi.cls == kSkipped || !(fi.len > 0)) continue;
-    if (!welded_ring(m_.faces[f].first_ring) || ws_.ring_tmp.size() < 3) continue;
-    // Project along the normal's largest component.
-    const double ax = std::fabs(fi.n.x), ay = std::fabs(fi.n.y), az = std::fabs(fi.n.z);
-    for (std::uint32_t v : ws_.ring_tmp) {
-      const V3& p = ws_.wpos[v];
-      pts.push_back(az >= ax && az >= ay ? Point2{p.x, p.y} : ay >= ax ? Point2{p.x, p.z} : Point2{p.y, p.z});
+    if (welded_ring(m_.faces[f].first_ring) && ws_.ring_tmp.size() >= 3) {
+      // Project along the normal's largest component.
+      const double ax = std::fabs(fi.n.x), ay = std::fabs(fi.n.y), az = std::fabs(fi.n.z);
+      for (std::uint32_t v : ws_.ring_tmp) {
+        const V3& p = ws_.wpos[v];
+        pts.push_back(az >= ax && az >= ay ? Point2{p.x, p.y} : ay >= ax ? Point2{p.x, p.z} : Point2{p.y, p.z});
+      }
+      ws_.face_pts_n[f] = static_cast<std::uint32_t>(ws_.ring_tmp.size());
     }
   }
-  start[nf] = static_cast<std::uint32_t>(pts.size());
+  n = ws_.face_pts_n[f];
+  return pts.data() + at[f];
 }
 
 void Decomposer::index_faces() {
@@ -114,21 +114,20 @@ void Decomposer::faces_near(const V3& p, const V3& q, bool walls) {
   if (walls) std::sort(G.near.begin(), G.near.end());
 }
 
-bool Decomposer::edge_on_face(std::uint32_t f, const V3& p, const V3& q) const {
+bool Decomposer::edge_on_face(std::uint32_t f, const V3& p, const V3& q) {
   const FaceInfo& fi = ws_.faces[f];
   const double t = tol_;
   if (std::min(p.x, q.x) > fi.hi.x + t || std::max(p.x, q.x) < fi.lo.x - t || std::min(p.y, q.y) > fi.hi.y + t ||
       std::max(p.y, q.y) < fi.lo.y - t || std::min(p.z, q.z) > fi.hi.z + t || std::max(p.z, q.z) < fi.lo.z - t)
     return false;
-  const std::uint32_t s = ws_.face_pts_start[f], e = ws_.face_pts_start[f + 1];
-  if (e - s < 3) return false;
   const double lim = t * fi.len;  // |n . d| / |n| <= tol
   if (std::fabs(dot(fi.n, p - fi.c)) > lim || std::fabs(dot(fi.n, q - fi.c)) > lim) return false;
+  std::size_t n = 0;
+  const Point2* ring = projected_face(f, n);
+  if (n < 3) return false;
   const V3 m{(p.x + q.x) / 2, (p.y + q.y) / 2, (p.z + q.z) / 2};
   const double ax = std::fabs(fi.n.x), ay = std::fabs(fi.n.y), az = std::fabs(fi.n.z);
   const Point2 mp = az >= ax && az >= ay ? Point2{m.x, m.y} : ay >= ax ? Point2{m.x, m.z} : Point2{m.y, m.z};
-  const Point2* ring = ws_.face_pts.data() + s;
-  const std::size_t n = e - s;
   if (inside(ring, n, mp)) return true;
   // On the boundary, within the tolerance.
   for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
@@ -148,7 +147,9 @@ void Decomposer::find_contacts() {
   bool any_floor = false, any_ceiling = false;
   for (const FaceInfo& fi : ws_.faces) any_floor |= fi.cls == kFloor, any_ceiling |= fi.cls == kCeiling;
   if (!any_floor && !any_ceiling) return;
-  project_faces();
+  ws_.face_pts_at.assign(ws_.faces.size(), kNone);
+  ws_.face_pts_n.resize(ws_.faces.size());
+  ws_.face_pts.clear();
   index_faces();
   const std::size_t nf = ws_.faces.size(), ng = ws_.group_count.size();
   auto& par = ws_.floor_uf;

@@ -182,6 +182,7 @@ struct Workspace {
   std::vector<std::uint32_t> plan_rep;  // plan-view merge of footprint-edge endpoints (rule 2)
   std::vector<std::uint32_t> open_edges;  // footprint edges left in chains that did not close
   std::vector<DirEdge> open_tmp;
+  std::vector<DirEdge> lower_edges;  // every lower-boundary edge while cand holds merged open ones
   struct Loop {
     std::uint32_t comp;
     double zmax;               // highest vertex (relative to the origin)
@@ -199,7 +200,9 @@ struct Workspace {
   /// down is the riser, and the patch's edge on it bounds the footprint (lower_boundary.cpp).
   std::vector<std::uint8_t> step_floor;
   std::vector<double> patch_plan_area, patch_down_len, patch_drop;  // per floor patch root, while hanging
-  std::vector<std::uint32_t> face_pts_start;  // contacts.cpp: each face's outer ring, projected along its normal
+  // contacts.cpp: a face's outer ring projected along its normal, made when an edge first reaches
+  // the point-in-face test (face_pts_at[f] kNone until then; face_pts_n[f] points from there)
+  std::vector<std::uint32_t> face_pts_at, face_pts_n;
   std::vector<Point2> face_pts;
   std::vector<std::uint8_t> on_roof;  // per edge group: its walls stand on another part's ceiling (contacts.cpp)
   /// contacts.cpp: the used faces bucketed by their plan boxes in an n x n grid (CSR), so that an edge
@@ -301,6 +304,7 @@ class Decomposer {
   std::uint32_t ng_ = 0;  // groups found by build_face_rings()
   std::size_t ncomp_ = 0;
   double lower_boundary_len_ = 0;  // plan length of all footprint edges (set when chains stay open)
+  bool lower_moved_ = false;  // chain_loops() moved every lower-boundary edge to ws_.lower_edges
 
   bool find_origin();
 
@@ -463,15 +467,16 @@ class Decomposer {
   /// Floors hang, and wall bottoms stand on roofs, where an edge of one part lies in a face of
   /// another (issue 21): ws_.hanging, ws_.on_roof.
   void find_contacts();
-  /// Each used face's outer ring projected along its normal's largest component (face_pts).
-  void project_faces();
+  /// Face f's outer ring projected along its normal's largest component, made on first use (most
+  /// faces are never tested: every face cost as much as the rest of the contacts on Macky).
+  const Point2* projected_face(std::uint32_t f, std::size_t& n);
   /// ws_.grid over the used faces' plan boxes.
   void index_faces();
   /// The used faces (floors and ceilings, and walls when `walls`) whose plan box meets the edge p q's
   /// widened by tol: ws_.grid.near, in increasing order when `walls`.
   void faces_near(const V3& p, const V3& q, bool walls);
   /// Whether the edge p q lies in face f within the weld tolerance (ends on its plane, midpoint on it).
-  bool edge_on_face(std::uint32_t f, const V3& p, const V3& q) const;
+  bool edge_on_face(std::uint32_t f, const V3& p, const V3& q);
 
   // ---- 7b. one footprint never overlaps itself (unite.cpp) ---------------------------------------
   /// Polygons whose boxes meet are united with the project's union engine (issue 21).

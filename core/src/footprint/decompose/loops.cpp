@@ -30,7 +30,11 @@ void Decomposer::chain_loops() {
   for (std::uint32_t e : ws_.open_edges) open.push_back(cand[e]);
   if (!merge_in_plan(open)) return;
   const std::size_t loops_before = ws_.loops.size();
+  // cand takes the merged open edges; every lower-boundary edge waits in lower_edges for
+  // close_in_plan() (collecting them again there cost as much as the first time).
+  ws_.lower_edges.swap(cand);
   cand.swap(open);
+  lower_moved_ = true;
   stats_->open_chains = 0;
   chain_pass(false);
   stats_->chained_in_plan = ws_.loops.size() - loops_before;

@@ -28,7 +28,8 @@
 namespace groundplan::footprint::detail {
 
 bool Decomposer::close_in_plan(std::vector<Polygon>& out) {
-  collect_footprint_edges();  // every lower-boundary edge (chain_loops() kept only the open ones)
+  // Every lower-boundary edge: chain_loops() may have put the merged open ones in their place.
+  if (lower_moved_) ws_.cand.swap(ws_.lower_edges), lower_moved_ = false;
   const std::vector<DirEdge>& cand = ws_.cand;
   if (cand.size() < 3) return false;
   const auto& P = ws_.wpos;
