@@ -238,46 +238,6 @@ std::string city(const test::TempDir& dir) {
   return (dir.path / "city").string();
 }
 
-TEST(TiledRunOverRanks, ThreadsAsRanksGiveTheOneProcessPlans) {
-  GDALAllRegister();
-  const test::TempDir dir("groundplan_tile_ranks");
-  PipelineOptions options;
-  options.inputs = {city(dir)};
-  options.ogr_input.id_field = "bid";
-  options.threads = 1;
-  const std::unique_ptr<TiledResult> one = run_pipeline_tiled(options);
-  const std::vector<std::string> expected = plan_rows(*one);
-  ASSERT_EQ(expected.size(), 37u);
-  EXPECT_GT(one->tiles.seam_plans, 0u);
-  for (int n : {2, 3, 4, 5, 9, 12}) {
-    ThreadRanks all(n);
-    std::vector<std::unique_ptr<TiledResult>> results(static_cast<std::size_t>(n));
-    std::vector<std::string> errors(static_cast<std::size_t>(n));
-    std::vector<std::thread> threads;
-    for (int r = 0; r < n; ++r)
-      threads.emplace_back([&, r] {
-        ThreadRanks::Rank me(all, r);
-        try {
-          results[static_cast<std::size_t>(r)] = run_pipeline_tiled(options, me);
-        } catch (const std::exception& e) {
-          errors[static_cast<std::size_t>(r)] = e.what();
-        }
-      });
-    for (std::thread& t : threads) t.join();
-    for (int r = 0; r < n; ++r) ASSERT_EQ(errors[static_cast<std::size_t>(r)], "") << n << " ranks, rank " << r;
-    const TiledResult& r0 = *results[0];
-    EXPECT_EQ(plan_rows(r0), expected) << n << " ranks";
-    EXPECT_EQ(r0.footprints, one->footprints);
-    EXPECT_EQ(r0.buildings_read, one->buildings_read);
-    EXPECT_EQ(r0.members_before(r0.plan_count()), one->members_before(one->plan_count()));
-    EXPECT_EQ(r0.tiles.final_plans + r0.tiles.reduced_plans, expected.size());
-    EXPECT_EQ(r0.tiles.final_plans, one->tiles.final_plans);
-    EXPECT_EQ(r0.tiles.seam_plans, one->tiles.seam_plans);
-    EXPECT_EQ(r0.ranks.size(), static_cast<std::size_t>(n));
-    for (int r = 1; r < n; ++r) EXPECT_EQ(results[static_cast<std::size_t>(r)]->plan_count(), 0u);
-  }
-}
-
 /// Runs `options` over n ranks played by threads; every rank's result, in rank order.
 std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOptions& options, int n, FinalPlans where) {
   ThreadRanks all(n);
@@ -297,6 +257,34 @@ std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOption
   for (int r = 0; r < n; ++r) EXPECT_EQ(errors[static_cast<std::size_t>(r)], "") << n << " ranks, rank " << r;
   return results;
 }
+
+TEST(TiledRunOverRanks, ThreadsAsRanksGiveTheOneProcessPlans) {
+  GDALAllRegister();
+  const test::TempDir dir("groundplan_tile_ranks");
+  PipelineOptions options;
+  options.inputs = {city(dir)};
+  options.ogr_input.id_field = "bid";
+  options.threads = 1;
+  const std::unique_ptr<TiledResult> one = run_pipeline_tiled(options);
+  const std::vector<std::string> expected = plan_rows(*one);
+  ASSERT_EQ(expected.size(), 37u);
+  EXPECT_GT(one->tiles.seam_plans, 0u);
+  for (int n : {2, 3, 4, 5, 9, 12}) {
+    const auto results = over_thread_ranks(options, n, FinalPlans::to_rank_0);
+    for (const auto& r : results) ASSERT_TRUE(r) << n << " ranks";
+    const TiledResult& r0 = *results[0];
+    EXPECT_EQ(plan_rows(r0), expected) << n << " ranks";
+    EXPECT_EQ(r0.footprints, one->footprints);
+    EXPECT_EQ(r0.buildings_read, one->buildings_read);
+    EXPECT_EQ(r0.members_before(r0.plan_count()), one->members_before(one->plan_count()));
+    EXPECT_EQ(r0.tiles.final_plans + r0.tiles.reduced_plans, expected.size());
+    EXPECT_EQ(r0.tiles.final_plans, one->tiles.final_plans);
+    EXPECT_EQ(r0.tiles.seam_plans, one->tiles.seam_plans);
+    EXPECT_EQ(r0.ranks.size(), static_cast<std::size_t>(n));
+    for (int r = 1; r < n; ++r) EXPECT_EQ(results[static_cast<std::size_t>(r)]->plan_count(), 0u);
+  }
+}
+
 
 // Stage 5 (every rank writes its own plans into a database): each rank keeps its final plans, and
 // plan_number/row_number put each where rank 0 has it when the plans are gathered, with the same global members;
