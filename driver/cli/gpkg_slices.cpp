@@ -3,12 +3,11 @@
 
 #include "sqlite_db.h"
 
-#include <cpl_conv.h>
+#include <cpl_port.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cctype>
 #include <filesystem>
 #include <set>
 #include <thread>
@@ -21,11 +20,6 @@ namespace {
 constexpr std::size_t kPlansPerWriter = 8192;
 // Writers at most: past this the appending (serial) is most of the time.
 constexpr int kMaxWriters = 16;
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 /// The ogr2ogr options that act on each feature alone (so a slice of the features gives a slice of the
 /// output), with how many values follow them. Anything else (-where on our FIDs, -sql, -limit, -fid,
@@ -62,7 +56,8 @@ void append_part(const sqlite::Db& db, const std::string& part, const std::strin
     while (s.row()) cols.push_back(s.text(1) + " " + s.text(2) + " " + s.text(3) + " " + s.text(5));
     return cols;
   };
-  if (columns("main") != columns("part") || columns("main").empty())
+  const std::vector<std::string> dst_columns = columns("main");
+  if (dst_columns.empty() || columns("part") != dst_columns)
     throw sqlite::Failure(part + ": the slice's table " + table + " is not the destination's");
   db.exec("INSERT INTO main." + id(table) + " SELECT * FROM part." + id(table));
   // gpkg_contents: the extent of all slices (min/max skip the NULLs of a slice without geometry).
@@ -133,7 +128,7 @@ int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::s
   const int writers = std::min(threads, by_plans);
   if (writers < 2)
     return one(threads < 2 ? "one thread" : "fewer than " + std::to_string(2 * kPlansPerWriter) + " plans");
-  if (std::none_of(layers.begin(), layers.end(), [&](const std::string& l) { return lower(l) == lower(plans_layer); }))
+  if (std::none_of(layers.begin(), layers.end(), [&](const std::string& l) { return EQUAL(l.c_str(), plans_layer.c_str()); }))
     return one("the " + plans_layer + " layer is not written");
   for (std::size_t i = 0; i < flags.size(); ++i) {
     const int n = per_feature_arity(flags[i]);

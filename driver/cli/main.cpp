@@ -376,15 +376,14 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
   int writers = 1;
   if (own_index && another) {
     auto* plans_layer = ds->layer("ground_plans");
-    writers = groundplan::cli::gpkg_writers(flags, layers, "ground_plans",
-                                            plans_layer ? static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE)) : 0,
-                                            n_threads, &why_one);
+    const std::size_t plans = plans_layer ? static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE)) : 0;
+    writers = groundplan::cli::gpkg_writers(flags, layers, "ground_plans", plans, n_threads, &why_one);
     if (writers > 1) {
       groundplan::cli::SliceWrite sw;
       sw.dst = ogr.dst;
       sw.flags = flags;
       sw.layers = layers;
-      sw.plans = static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE));
+      sw.plans = plans;
       sw.writers = writers;
       sw.progress = ogr.progress && !ogr.quiet;
       const int per_writer = std::max(1, n_threads / writers);

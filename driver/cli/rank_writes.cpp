@@ -6,17 +6,12 @@
 #include <gdal_utils.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <set>
 
 namespace groundplan::cli {
 namespace {
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -120,7 +115,7 @@ CPLStringList open_options(const std::vector<std::string>& options) {
 }  // namespace
 
 bool written_by_every_rank(const std::string& format, const std::string& dst) {
-  if (!format.empty()) return lower(format) == "postgresql";
+  if (!format.empty()) return EQUAL(format.c_str(), "PostgreSQL");
   return dst.rfind("PG:", 0) == 0 || dst.rfind("pg:", 0) == 0;
 }
 

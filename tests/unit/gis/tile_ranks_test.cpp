@@ -258,13 +258,19 @@ std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOption
   return results;
 }
 
-TEST(TiledRunOverRanks, ThreadsAsRanksGiveTheOneProcessPlans) {
-  GDALAllRegister();
-  const test::TempDir dir("groundplan_tile_ranks");
+/// The tiled run of city(dir), one thread, building ids from the "bid" field.
+PipelineOptions city_options(const test::TempDir& dir) {
   PipelineOptions options;
   options.inputs = {city(dir)};
   options.ogr_input.id_field = "bid";
   options.threads = 1;
+  return options;
+}
+
+TEST(TiledRunOverRanks, ThreadsAsRanksGiveTheOneProcessPlans) {
+  GDALAllRegister();
+  const test::TempDir dir("groundplan_tile_ranks");
+  const PipelineOptions options = city_options(dir);
   const std::unique_ptr<TiledResult> one = run_pipeline_tiled(options);
   const std::vector<std::string> expected = plan_rows(*one);
   ASSERT_EQ(expected.size(), 37u);
@@ -292,10 +298,7 @@ TEST(TiledRunOverRanks, ThreadsAsRanksGiveTheOneProcessPlans) {
 TEST(TiledRunOverRanks, KeptPlansAreNumberedAsRankZeroGathersThem) {
   GDALAllRegister();
   const test::TempDir dir("groundplan_tile_ranks_kept");
-  PipelineOptions options;
-  options.inputs = {city(dir)};
-  options.ogr_input.id_field = "bid";
-  options.threads = 1;
+  const PipelineOptions options = city_options(dir);
   for (int n : {2, 3, 5}) {
     const auto gathered = over_thread_ranks(options, n, FinalPlans::to_rank_0);
     const auto kept = over_thread_ranks(options, n, FinalPlans::kept_by_each_rank);
