@@ -10,7 +10,8 @@ include(CMakePackageConfigHelpers)
 add_library(libgroundplan SHARED ${CMAKE_SOURCE_DIR}/packaging/libgroundplan.cpp $<TARGET_OBJECTS:groundplan_core>
                                   $<TARGET_OBJECTS:groundplan_gis> $<TARGET_OBJECTS:groundplan_geosref>)
 target_link_libraries(libgroundplan PRIVATE groundplan_flags PkgConfig::MPFR TBB::tbb PROJ::proj EXPAT::EXPAT
-                                            GEOS::geos_c GDAL::GDAL groundplan_geographiclib PkgConfig::GMPXX simdjson::simdjson)
+                                            GEOS::geos_c GDAL::GDAL groundplan_geographiclib PkgConfig::GMPXX simdjson::simdjson
+                                            pugixml::static)
 if(TARGET CUDA::cudart)
   target_link_libraries(libgroundplan PRIVATE CUDA::cudart)
 endif()

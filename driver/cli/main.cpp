@@ -332,8 +332,11 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   const groundplan::gis::ReadStats& rs = result.reading;
   nlohmann::json whole = nlohmann::json::array();
   for (const auto& [file, why] : rs.read_whole) whole.push_back({{"file", file}, {"why", why}});
+  nlohmann::json streamed = nlohmann::json::array();
+  for (const auto& [file, why] : rs.xml_streamed) streamed.push_back({{"file", file}, {"why", why}});
   j["reading"] = {{"threads", rs.threads}, {"files", rs.files},       {"bytes", rs.bytes},
-                  {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole}};
+                  {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole},
+                  {"xml_streamed", streamed}};
   j["raster_backend"] = result.raster_backend;
   if (written && written->own_index && written->ok)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
     j["spatial_index"] = spatial_index_json(written->built);

@@ -210,6 +210,7 @@ void detail::merge_file(detail::FileRead&& r, const std::string& file, detail::R
   } else if (!r.whole_reason.empty()) {
     result.reading.read_whole.emplace_back(file, r.whole_reason);
   }
+  if (!r.xml_streamed_why.empty()) result.reading.xml_streamed.emplace_back(file, r.xml_streamed_why);
 }
 
 namespace {

@@ -9,6 +9,7 @@
 #include <cpl_conv.h>
 #include <cpl_vsi.h>
 
+#include "citygml/in_memory.h"
 #include "cityjson/read_into.h"
 #include "gzip_progress.h"
 
@@ -206,6 +207,7 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
   if (info.format == InputFormat::CityGml) {
     CityGmlOptions opt;
     opt.lod = options.lod;
+    opt.dom_max_bytes = citygml::in_memory_bytes();
     std::uint64_t unpacked = 0;
     if (max_bytes || options.on_bytes)
       opt.on_bytes = [&](std::uint64_t n) {

@@ -5,9 +5,14 @@
 # and with --threads 1, reading scaling over 1..16 threads, the GeoPackage writer against ogr2ogr copying
 # the same features, CPU time and peak RSS (/usr/bin/time), and the outputs' hashes (the same whatever
 # the threads or the cut). Usage, from the repository root:
-#   tests/bench/city_scale_on_device.sh BUNDLE.tar.xz [CITY_MB] [BIG_CITY_MB]
+#   [SECTIONS="same e2e index alloc copy scaling xml bench"] tests/bench/city_scale_on_device.sh BUNDLE.tar.xz [CITY_MB] [BIG_CITY_MB]
+# SECTIONS picks what runs (default: all but xml and bench); "xml" times the CityGML reader in memory (pugixml,
+# the default) against streamed through expat (--config GROUNDPLAN_XML_IN_MEMORY_BYTES 0) in alternated rounds,
+# "bench" runs citygml_read_bench (packed with PACK_EXTRA_BINS) on two real samples and a 60 MB generated city.
 set -u
 BUNDLE=${1:?BUNDLE}; MB=${2:-1500}; BIG_MB=${3:-0}
+SECTIONS=${SECTIONS:-"same e2e index alloc copy scaling"}
+want() { [[ " $SECTIONS " == *" $1 "* ]]; }
 OUT=${OUT:-city-scale-out}; mkdir -p "$OUT"
 exec > >(tee "$OUT/city_scale.log") 2>&1
 W=/tmp/gp-city
@@ -43,27 +48,56 @@ s=$(date +%s); python3 tests/bench/gen_big_citygml.py "$W/city.gml" "$MB" | tail
 python3 tests/bench/split_citygml_tiles.py "$W/city.gml" 16 "$W/tiles" | tail -1; echo "  made in $(( $(date +%s) - s )) s"
 cat "$W/city.gml" > /dev/null; cat "$W"/tiles/* > /dev/null  # in the page cache, as for every run below
 
-echo "== same output whatever the threads and the cut (ground_plans as CSV WKT)"
+if want same; then
+echo "== same output whatever the threads, the cut and the XML parser (ground_plans as CSV WKT)"
 gp csv_t1 -f CSV -lco GEOMETRY=AS_WKT "$W/csv_t1.csv" "$W/city.gml" --threads 1
 gp csv_t16 -f CSV -lco GEOMETRY=AS_WKT "$W/csv_t16.csv" "$W/city.gml"
 gp csv_tiles -f CSV -lco GEOMETRY=AS_WKT "$W/csv_tiles.csv" "$W/tiles"
 # From 1 GiB in 2+ files the folder goes through the tiled run by default (issue 15: same plans, final ones
 # first, rings may start elsewhere); --tiles off is the one-process run, byte-identical to the single file.
 gp csv_tiles_off -f CSV -lco GEOMETRY=AS_WKT "$W/csv_tiles_off.csv" "$W/tiles" --tiles off
-md5sum "$W"/csv_t1.csv "$W"/csv_t16.csv "$W"/csv_tiles.csv "$W"/csv_tiles_off.csv | sed "s#$W/##"
+gp csv_t16_expat -f CSV -lco GEOMETRY=AS_WKT "$W/csv_t16_expat.csv" "$W/city.gml" --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
+md5sum "$W"/csv_t1.csv "$W"/csv_t16.csv "$W"/csv_tiles.csv "$W"/csv_tiles_off.csv "$W"/csv_t16_expat.csv | sed "s#$W/##"
 python3 - "$W/csv_t1.csv" "$W/csv_tiles.csv" <<'PY'
 import sys
 a, b = (sorted(open(f).read().splitlines()[1:]) for f in sys.argv[1:3])
 print("tiled run: %d plans, one process: %d; as sorted lines equal: %s" % (len(b), len(a), a == b))
 PY
+fi
 
+if want xml; then
+  echo "== CityGML in memory (pugixml, default) against streamed (expat), alternated rounds, all cores and one"
+  for i in 1 2 3; do
+    gp "mem_file_$i" -f GPKG "$W/mem_file_$i.gpkg" "$W/city.gml"
+    gp "expat_file_$i" -f GPKG "$W/expat_file_$i.gpkg" "$W/city.gml" --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
+    gp "mem_tiles_$i" -f GPKG "$W/mem_tiles_$i.gpkg" "$W/tiles" --tiles off
+    gp "expat_tiles_$i" -f GPKG "$W/expat_tiles_$i.gpkg" "$W/tiles" --tiles off --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
+  done
+  gp mem_file_t1 -f GPKG "$W/mem_file_t1.gpkg" "$W/city.gml" --threads 1
+  gp expat_file_t1 -f GPKG "$W/expat_file_t1.gpkg" "$W/city.gml" --threads 1 --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
+  for t in 2 4 8; do gp "mem_scale_t$t" -f GPKG "$W/mem_scale_t$t.gpkg" "$W/city.gml" --threads $t; done
+  python3 - "$W/mem_file_1.json" <<'PY'
+import json, sys
+print("xml_streamed of the in-memory run:", json.load(open(sys.argv[1]))["reading"].get("xml_streamed"))
+PY
+fi
+if want bench && [ -x $G/bin/citygml_read_bench ]; then
+  echo "== one core: citygml_read_bench (CPU-time medians), two real samples and a 60 MB city of the generator"
+  python3 tests/bench/gen_big_citygml.py "$W/c60.gml" 60 | tail -1
+  $G/bin/citygml_read_bench --runs 5 sample_data/niedersachsen-lorup/LoD1_24065862_2_2021-01-25.gml \
+    sample_data/plateau-niiza/53395404_bldg_6697_op.gml "$W/c60.gml"
+fi
+
+if want e2e; then
 echo "== end to end to GeoPackage (3 runs each with all cores)"
 for i in 1 2 3; do gp "file_all_$i" -f GPKG "$W/file_all_$i.gpkg" "$W/city.gml"; done
 for i in 1 2 3; do gp "tiles_all_$i" -f GPKG "$W/tiles_all_$i.gpkg" "$W/tiles"; done
 for i in 1 2 3; do gp "tiles_off_$i" -f GPKG "$W/tiles_off_$i.gpkg" "$W/tiles" --tiles off; done
 gp file_t1 -f GPKG "$W/file_t1.gpkg" "$W/city.gml" --threads 1
 gp tiles_t1 -f GPKG "$W/tiles_t1.gpkg" "$W/tiles" --threads 1
+fi
 
+if want index; then
 echo "== GeoPackage spatial index: packed by us (above) against GDAL's own (-lco SPATIAL_INDEX=YES), and none"
 for i in 1 2 3; do gp "file_gdalidx_$i" -f GPKG "$W/file_gdalidx_$i.gpkg" "$W/city.gml" -lco SPATIAL_INDEX=YES; done
 gp file_noidx -f GPKG "$W/file_noidx.gpkg" "$W/city.gml" -lco SPATIAL_INDEX=NO
@@ -76,6 +110,8 @@ print("index entries equal:", list(a.execute(q)) == list(b.execute(q)), "| schem
       list(a.execute(schema)) == list(b.execute(schema)), "| rtreecheck:",
       a.execute("SELECT rtreecheck('rtree_ground_plans_geom')").fetchone()[0])
 PY
+fi
+if want alloc; then
 echo "== glibc malloc kept from returning memory to the kernel (GLIBC_TUNABLES), one file, all cores"
 for i in 1 2 3; do GLIBC_TUNABLES=glibc.malloc.mmap_threshold=67108864:glibc.malloc.trim_threshold=1073741824 \
   gp "file_tunables_$i" -f GPKG "$W/file_tunables_$i.gpkg" "$W/city.gml"; done
@@ -83,9 +119,10 @@ if [ -e $G/lib/libtbbmalloc_proxy.so.2 ]; then
   echo "== TBB's allocator (LD_PRELOAD libtbbmalloc_proxy) against glibc's, one file, all cores"
   for i in 1 2 3; do LD_PRELOAD=$G/lib/libtbbmalloc_proxy.so.2 gp "file_tbbmalloc_$i" -f GPKG "$W/file_tbbmalloc_$i.gpkg" "$W/city.gml"; done
 fi
+fi
 
 echo "== the writer against ogr2ogr copying the same features (GPKG -> GPKG)"
-if [ -x $G/bin/ogr2ogr ]; then
+if want copy && [ -x $G/bin/ogr2ogr ] && [ -e "$W/file_all_1.gpkg" ]; then
   for i in 1 2 3; do
     rm -f "$W/copy.gpkg"; s=$(date +%s%N)
     $G/bin/ogr2ogr -f GPKG "$W/copy.gpkg" "$W/file_all_1.gpkg" ground_plans
@@ -94,7 +131,7 @@ if [ -x $G/bin/ogr2ogr ]; then
 fi
 
 echo "== reading scaling (one file, CSV output; 1 and 16 threads: csv_t1, csv_t16 above)"
-for t in 2 4 8; do gp "scale_t$t" -f CSV -lco GEOMETRY=AS_WKT "$W/scale_t$t.csv" "$W/city.gml" --threads $t; done
+want scaling && for t in 2 4 8; do gp "scale_t$t" -f CSV -lco GEOMETRY=AS_WKT "$W/scale_t$t.csv" "$W/city.gml" --threads $t; done
 
 if [ "$BIG_MB" != 0 ]; then
   echo "== big city: $BIG_MB MB"
@@ -102,5 +139,9 @@ if [ "$BIG_MB" != 0 ]; then
   s=$(date +%s); python3 tests/bench/gen_big_citygml.py "$W/big.gml" "$BIG_MB" | tail -1; echo "  made in $(( $(date +%s) - s )) s"
   cat "$W/big.gml" > /dev/null
   gp big_all -f GPKG "$W/big.gpkg" "$W/big.gml"
+  if want xml; then
+    gp big_all_2 -f GPKG "$W/big.gpkg" "$W/big.gml"
+    gp big_expat -f GPKG "$W/big.gpkg" "$W/big.gml" --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
+  fi
 fi
 echo "== done"

@@ -46,6 +46,28 @@ def test_same_files_whatever_the_threads_and_the_cut(tmp_path, src):
     assert many == one
 
 
+XML_SAMPLES = [SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", SHARED_DATA / "citygml2-plateau-japan-lod1",
+               SHARED_DATA / "citygml1-berlin-lod2-libcitygml" / "berlin_open_data_sample_data.citygml",
+               SHARED_DATA / "citygml-citygml4j-samples" / "lod2_buildings_v3.gml",
+               SHARED_DATA / "citygml-ogc-spec-samples" / "Opera-Lyon_CityGML3.0_LOD2_with_xAL3_FreeText.gml"]
+
+
+@pytest.mark.parametrize("src", XML_SAMPLES, ids=lambda p: p.name)
+def test_same_files_whether_parsed_in_memory_or_streamed(tmp_path, src):
+    """pugixml in memory (the default) and expat streaming (GROUNDPLAN_XML_IN_MEMORY_BYTES 0) give the same
+    files, whole and in chunks; --stats says which files expat read."""
+    cut = ["--threads", "3", "--read-chunk-bytes", "16384"]
+    memory, memory_stats = csv_hashes(tmp_path, "memory", src, *cut)
+    streamed, streamed_stats = csv_hashes(tmp_path, "streamed", src, *cut,
+                                          "--config", "GROUNDPLAN_XML_IN_MEMORY_BYTES", "0")
+    whole, _ = csv_hashes(tmp_path, "whole", src, "--threads", "1", "--read-chunk-bytes", "-1",
+                          "--config", "GROUNDPLAN_XML_IN_MEMORY_BYTES", "0")
+    assert memory is not None and memory == streamed == whole
+    assert memory_stats["reading"]["xml_streamed"] == []
+    assert streamed_stats["reading"]["xml_streamed"], streamed_stats["reading"]
+    assert all(e["why"] == "parsing in memory is off" for e in streamed_stats["reading"]["xml_streamed"])
+
+
 def test_threads_from_gdal_num_threads_and_flag(tmp_path):
     src = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
     _, stats = csv_hashes(tmp_path, "cfg", src, "--config", "GDAL_NUM_THREADS", "2")

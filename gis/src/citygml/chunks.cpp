@@ -204,6 +204,8 @@ std::string merge_citygml_chunks(const std::string& path, const CityGmlChunkPlan
     merged.faces += in.faces;
     merged.xlinks_resolved += in.xlinks_resolved;
     merged.xlinks_missing += in.xlinks_missing;
+    merged.bytes_streamed += in.bytes_streamed;
+    if (merged.streamed_why.empty()) merged.streamed_why = in.streamed_why;
   }
   // A gml:id in two chunks: each chunk's reader saw only its own (DUPLICATE_ID is said per file).
   // Sorted on all cores: one hash set of every id would be a serial pass over the whole file's ids.

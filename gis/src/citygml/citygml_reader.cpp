@@ -17,6 +17,7 @@
 #include "citygml/coordinates.h"
 #include "citygml/element_names.h"
 #include "citygml/file_problems.h"
+#include "xml/dom_events.h"
 
 #include <cpl_vsi.h>
 #include <expat.h>
@@ -122,7 +123,7 @@ void copy_faces(const Mesh& from, std::uint32_t first, std::uint32_t last, Mesh&
   }
 }
 
-class Reader {
+class Reader : private xml::DomEvents::Sink {
  public:
   /// `watch`: set when this reader reads one chunk of a file (citygml_chunks.h); it then records what
   /// could make the chunk read differently from the whole file, and leaves file-level problems out.
@@ -169,6 +170,46 @@ class Reader {
     return n;
   }
 
+  /// Reads the whole document [data, data + n) through pugixml (xml/dom_events.h), handing the
+  /// same events as expat. False, with nothing read, when the document is left to expat (larger than
+  /// CityGmlOptions::dom_max_bytes, or one pugixml would read otherwise); then feed() the same bytes.
+  bool read_dom(const char* data, std::size_t n) {
+    if (n == 0) {  // expat says what an empty document is
+      streamed_because("the document is empty");
+      return false;
+    }
+    if (n > opt_.dom_max_bytes) {
+      streamed_because(too_large());
+      return false;
+    }
+    xml::DomEvents dom;
+    if (std::string why = dom.load(data, n); !why.empty()) {
+      streamed_because(std::move(why));
+      return false;
+    }
+    info_.bytes += n;
+    dom_ = &dom;
+    struct Detach {
+      xml::DomEvents*& dom;
+      ~Detach() { dom = nullptr; }
+    } detach{dom_};
+    dom.walk(*this);
+    if (!stop_reason_.empty()) {
+      salvage(stop_reason_);
+      throw InputError(name_ + ": " + stop_reason_);
+    }
+    return true;
+  }
+
+  /// Says (SourceInfo::streamed_why) why the document goes to expat; the first reason is kept.
+  void streamed_because(std::string why) {
+    if (info_.streamed_why.empty()) info_.streamed_why = std::move(why);
+  }
+  /// Why a document past CityGmlOptions::dom_max_bytes is streamed.
+  std::string too_large() const {
+    return opt_.dom_max_bytes ? "larger than " + std::to_string(opt_.dom_max_bytes) + " bytes" : "parsing in memory is off";
+  }
+
   void finish() {
     // Buildings still waiting for a forward xlink target: the target never came.
     while (!pending_.empty()) {
@@ -183,6 +224,7 @@ class Reader {
  private:
   void parse_buffer(std::size_t n, bool last) {
     info_.bytes += n;
+    info_.bytes_streamed += n;
     if (last && info_.bytes == 0) throw InputError(name_ + ": the file is empty (0 bytes): nothing to read");
     XML_Status st = XML_ParseBuffer(parser_, static_cast<int>(n), last ? XML_TRUE : XML_FALSE);
     if (pending_exception_) std::rethrow_exception(pending_exception_);
@@ -233,8 +275,18 @@ class Reader {
 
   void stop(std::string reason) {
     if (stop_reason_.empty()) stop_reason_ = std::move(reason);
-    XML_StopParser(parser_, XML_FALSE);
+    if (!dom_) XML_StopParser(parser_, XML_FALSE);
   }
+
+  /// The line of the element being started or ended, from whichever parser reads.
+  std::size_t current_line() const {
+    return dom_ ? dom_->line() : static_cast<std::size_t>(XML_GetCurrentLineNumber(parser_));
+  }
+
+  // xml::DomEvents::Sink: start() and end() are the reader's own (below).
+  bool wants_text() const override { return capture_ != Capture::None; }
+  void text(const char* s, std::size_t n) override { append_text(s, n); }
+  bool stopped() const override { return !stop_reason_.empty(); }
 
   static void XMLCALL on_entity_decl(void* ud, const XML_Char* name, int, const XML_Char*, int, const XML_Char*,
                                      const XML_Char*, const XML_Char*, const XML_Char*) {
@@ -278,14 +330,15 @@ class Reader {
     }
   }
   static void XMLCALL on_text(void* ud, const XML_Char* s, int len) {
-    auto* self = static_cast<Reader*>(ud);
+    static_cast<Reader*>(ud)->append_text(s, static_cast<std::size_t>(len));
+  }
+  void append_text(const char* s, std::size_t n) {
     // Bounded whatever the document claims or holds (issue 8: a "2 GB coordinate list").
-    const std::size_t n = static_cast<std::size_t>(len);
-    if (self->text_.size() + n > self->opt_.max_coordinate_chars) {
-      self->text_overflow_ = true;
+    if (text_.size() + n > opt_.max_coordinate_chars) {
+      text_overflow_ = true;
       return;
     }
-    self->text_.append(s, n);
+    text_.append(s, n);
   }
 
   void begin_capture(Capture c) {
@@ -302,7 +355,7 @@ class Reader {
 
   BuildingCtx* building() { return buildings_.empty() ? nullptr : buildings_.back().get(); }
 
-  void start(const char* name, const char** atts) {
+  void start(const char* name, const char** atts) override {
     if (skip_depth_) {  // inside a subtree we ignore entirely
       if (++skip_level_ + frames_.size() > opt_.max_depth)
         stop("XML nesting deeper than " + std::to_string(opt_.max_depth) + " levels; refused as hostile or broken");
@@ -436,7 +489,7 @@ class Reader {
     skip_level_ = 1;
   }
 
-  void end() {
+  void end() override {
     if (skip_depth_) {
       if (--skip_level_ == 0) skip_depth_ = false;
       return;
@@ -566,7 +619,7 @@ class Reader {
       if (watch_) watch_->position_dependent = true;  // the id holds a running count and a line number
       ctx->mesh.source_id = std::string(is_part ? "BuildingPart" : "Building") + "#" +
                             std::to_string(info_.buildings + info_.building_parts) + "@line" +
-                            std::to_string(XML_GetCurrentLineNumber(parser_));
+                            std::to_string(current_line());
     }
     if (BuildingCtx* parent = building()) {
       parent->has_parts = true;
@@ -807,7 +860,7 @@ class Reader {
 
   std::string poly_label() const {
     if (watch_ && poly_id_.empty()) watch_->position_dependent = true;
-    return poly_id_.empty() ? "at line " + std::to_string(XML_GetCurrentLineNumber(parser_)) : "\"" + poly_id_ + "\"";
+    return poly_id_.empty() ? "at line " + std::to_string(current_line()) : "\"" + poly_id_ + "\"";
   }
 
   void add_coordinates(BuildingCtx& b, const Frame& f) {
@@ -944,6 +997,7 @@ class Reader {
   SourceInfo& info_;
   CityGmlChunkWatch* watch_ = nullptr;
   XML_Parser parser_ = nullptr;
+  xml::DomEvents* dom_ = nullptr;  // set while read_dom() walks a document
   NameSplitter names_;
   std::exception_ptr pending_exception_;
   std::string stop_reason_;
@@ -1008,6 +1062,38 @@ VsiHandle open_file(const std::string& path) {
   if (!f) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
   return f;
 }
+
+/// Bytes read into memory for the DOM path, without zero-filling them first.
+class ByteBuffer {
+ public:
+  char* data() { return bytes_.get(); }
+  std::size_t size() const { return size_; }
+  /// Room for `extra` more bytes past size(); returns where they go.
+  char* grow(std::size_t extra) {
+    if (size_ + extra > capacity_) {
+      const std::size_t cap = std::max(size_ + extra, 2 * capacity_);
+      std::unique_ptr<char[]> bigger(new char[cap]);
+      if (size_) std::memcpy(bigger.get(), bytes_.get(), size_);
+      bytes_ = std::move(bigger);
+      capacity_ = cap;
+    }
+    return bytes_.get() + size_;
+  }
+  void append(const char* s, std::size_t n) {
+    if (n) std::memcpy(grow(n), s, n);
+    size_ += n;
+  }
+  void added(std::size_t n) { size_ += n; }
+
+ private:
+  std::unique_ptr<char[]> bytes_;
+  std::size_t size_ = 0, capacity_ = 0;
+};
+
+/// Gives `reader` the bytes [data, data + n) through expat, in pieces of at most kChunk.
+void feed_expat(Reader& reader, const char* data, std::size_t n) {
+  for (std::size_t off = 0; off < n; off += kChunk) reader.feed(data + off, std::min<std::size_t>(kChunk, n - off), false);
+}
 }  // namespace
 
 void read_citygml(const std::string& path, const CityGmlOptions& options, const MeshCallback& on_mesh,
@@ -1015,6 +1101,26 @@ void read_citygml(const std::string& path, const CityGmlOptions& options, const 
   const VsiHandle file = open_file(path);
   VSILFILE* fp = file.get();
   Reader reader(path, options, on_mesh, problems, info);
+  // Up to dom_max_bytes into memory: a file that ends within them is read through pugixml. A larger one
+  // (or one pugixml would read otherwise) is given to expat, those bytes first, then streamed.
+  ByteBuffer head;
+  bool ended = false;
+  VSIStatBufL st;  // room for the whole file at once where its size is known cheaply (not through a gzip)
+  if (!ended && path.rfind("/vsigzip/", 0) != 0 && VSIStatExL(path.c_str(), &st, VSI_STAT_SIZE_FLAG) == 0 &&
+      static_cast<std::uint64_t>(st.st_size) <= options.dom_max_bytes)
+    head.grow(static_cast<std::size_t>(st.st_size) + kChunk);
+  while (options.dom_max_bytes && !ended && head.size() <= options.dom_max_bytes) {
+    const std::size_t n = VSIFReadL(head.grow(kChunk), 1, kChunk, fp);
+    head.added(n);
+    if (options.on_bytes && n) options.on_bytes(n);
+    ended = n < static_cast<std::size_t>(kChunk);
+  }
+  if (ended && reader.read_dom(head.data(), head.size())) {
+    reader.finish();
+    return;
+  }
+  if (!ended) reader.streamed_because(reader.too_large());
+  feed_expat(reader, head.data(), head.size());
   for (;;) {
     std::size_t n = reader.feed_from([&](void* buf, std::size_t cap) { return VSIFReadL(buf, 1, cap, fp); });
     if (options.on_bytes && n) options.on_bytes(n);
@@ -1026,13 +1132,10 @@ void read_citygml(const std::string& path, const CityGmlOptions& options, const 
 void read_citygml_buffer(std::string_view xml, const std::string& name, const CityGmlOptions& options,
                          const MeshCallback& on_mesh, std::vector<Problem>& problems, SourceInfo& info) {
   Reader reader(name, options, on_mesh, problems, info);
-  std::size_t off = 0;
-  do {
-    std::size_t n = std::min<std::size_t>(kChunk, xml.size() - off);
-    reader.feed(xml.data() + off, n, false);
-    off += n;
-  } while (off < xml.size());
-  reader.feed(nullptr, 0, true);
+  if (!reader.read_dom(xml.data(), xml.size())) {
+    feed_expat(reader, xml.data(), xml.size());
+    reader.feed(nullptr, 0, true);
+  }
   reader.finish();
 }
 
@@ -1045,16 +1148,40 @@ void read_citygml_chunk(const std::string& path, const CityGmlChunkPlan& plan, s
   VSILFILE* fp = file.get();
   if (VSIFSeekL(fp, begin, SEEK_SET) != 0) throw InputError(path + ": cannot seek to byte " + std::to_string(begin));
   Reader reader(path, options, on_mesh, problems, info, &watch);
-  reader.feed(plan.head.data(), plan.head.size(), false);
-  std::uint64_t left = end - begin;
-  while (left > 0) {
-    const std::size_t n = reader.feed_from([&](void* buf, std::size_t cap) {
-      return VSIFReadL(buf, 1, static_cast<std::size_t>(std::min<std::uint64_t>(cap, left)), fp);
-    }, false);
-    if (n == 0) throw InputError(path + ": the file ends before byte " + std::to_string(end) + " (changed while read?)");
-    left -= n;
-    if (options.on_bytes) options.on_bytes(n);
+  const auto read_range = [&](const auto& take) {
+    std::uint64_t left = end - begin;
+    while (left > 0) {
+      const std::size_t n = take(static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, left)));
+      if (n == 0)
+        throw InputError(path + ": the file ends before byte " + std::to_string(end) + " (changed while read?)");
+      left -= n;
+      if (options.on_bytes) options.on_bytes(n);
+    }
+  };
+  const std::uint64_t whole = plan.head.size() + (end - begin) + (last ? 0 : plan.tail.size());
+  if (whole <= options.dom_max_bytes) {
+    // The chunk as one document in memory (head, range, tail), read through pugixml.
+    ByteBuffer doc;
+    doc.grow(static_cast<std::size_t>(whole));
+    doc.append(plan.head.data(), plan.head.size());
+    read_range([&](std::size_t cap) {
+      const std::size_t n = VSIFReadL(doc.grow(cap), 1, cap, fp);
+      doc.added(n);
+      return n;
+    });
+    if (!last) doc.append(plan.tail.data(), plan.tail.size());
+    if (!reader.read_dom(doc.data(), doc.size())) {
+      feed_expat(reader, doc.data(), doc.size());
+      reader.feed(nullptr, 0, true);
+    }
+    reader.finish();
+    return;
   }
+  reader.streamed_because(reader.too_large());
+  reader.feed(plan.head.data(), plan.head.size(), false);
+  read_range([&](std::size_t cap) {
+    return reader.feed_from([&](void* buf, std::size_t) { return VSIFReadL(buf, 1, cap, fp); }, false);
+  });
   if (!last) reader.feed(plan.tail.data(), plan.tail.size(), false);
   reader.feed(nullptr, 0, true);
   reader.finish();

@@ -4,6 +4,7 @@
 // whole-file reading would give; otherwise, and when that check fails, the file is read whole, its
 // footprints made on the other cores while the reader reads on.
 #include "pipeline/file_reading.h"
+#include "citygml/in_memory.h"
 
 #include <groundplan/error.h>
 #include <groundplan/gis/citygml_chunks.h>
@@ -294,6 +295,7 @@ void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info
   out.buildings_read += given_up.size();
   out.buildings_dropped += given_up.size();
   out.delivered = std::any_of(delivered.begin(), delivered.end(), [](const auto& set) { return !set.empty(); });
+  if (info.citygml.bytes_streamed) out.xml_streamed_why = info.citygml.streamed_why;
   if (info.in_working_crs) {
     if (!options.s_srs.empty())
       out.problems.push_back({"", file, "georeference", "NOTE",
@@ -444,6 +446,7 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
   std::vector<CityGmlChunkWatch> watches(n);
   CityGmlOptions citygml;
   citygml.lod = options.lod;
+  citygml.dom_max_bytes = citygml::in_memory_bytes();
   citygml.on_bytes = [&bytes](std::uint64_t b) { bytes.add(b); };
   SideBySide s;
   why = read_side_by_side(file, options, context, infos, [&](std::size_t k, const auto& on_mesh, auto& problems) {
@@ -501,10 +504,11 @@ std::optional<FileRead> read_ogr_ranges(const std::string& file, const OgrRangeP
 }
 
 /// Bytes per chunk when `shared` bytes are read with `threads` threads: about four chunks a thread,
-/// 2-64 MiB each (a chunk re-reads the file's head, and a thread should not wait on one huge chunk).
+/// 2-32 MiB each (a chunk re-reads the file's head, and a thread should not wait on one huge chunk; a
+/// chunk with its head stays under CityGmlOptions::dom_max_bytes, so that it is parsed in memory).
 std::uint64_t auto_chunk_bytes(std::uint64_t shared, std::size_t threads) {
   const std::uint64_t per = shared / (4 * std::max<std::size_t>(threads, 1));
-  return std::clamp<std::uint64_t>(per, std::uint64_t{2} << 20, std::uint64_t{64} << 20);
+  return std::clamp<std::uint64_t>(per, std::uint64_t{2} << 20, std::uint64_t{32} << 20);
 }
 
 }  // namespace
@@ -521,11 +525,13 @@ void ByteProgress::add(std::uint64_t n) {
 FileRead read_file(const std::string& file, const PipelineOptions& options, const ReadContext& context,
                    std::size_t threads, std::uint64_t shared_bytes, ByteProgress& bytes) {
   std::string whole_reason;
-  const bool may_cut = options.read_chunk_bytes >= 0 && (options.read_chunk_bytes > 0 || threads > 1);
-  if (may_cut && detect_format(file) == InputFormat::CityGml) {
+  if (options.read_chunk_bytes >= 0 && detect_format(file) == InputFormat::CityGml) {
     VSIStatBufL st;
-    if (VSIStatL(file.c_str(), &st) == 0) {
-      const auto size = static_cast<std::uint64_t>(st.st_size);
+    const auto size = VSIStatL(file.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+    // Cut for threads, or, on one thread, so that a file too large to be parsed in memory is read in
+    // chunks that are (citygml.h dom_max_bytes: pugixml instead of expat's slower streaming).
+    const std::uint64_t in_memory = citygml::in_memory_bytes();
+    if (size > 0 && (options.read_chunk_bytes > 0 || threads > 1 || (in_memory > 0 && size > in_memory))) {
       const std::uint64_t chunk = options.read_chunk_bytes > 0 ? static_cast<std::uint64_t>(options.read_chunk_bytes)
                                                                : auto_chunk_bytes(std::max(size, shared_bytes), threads);
       if (size >= 2 * chunk) {

@@ -41,6 +41,7 @@ struct FileRead {
   // How it was read (--stats).
   std::size_t chunks = 0;             // > 0: CityGML read in this many chunks side by side
   std::string whole_reason;           // CityGML read whole although cutting was asked for: why
+  std::string xml_streamed_why;       // CityGML streamed through expat (some or all of it), not parsed in memory: why
   double footprint_wait_s = 0;        // read whole: the wait for its footprints after its last byte
 };
 

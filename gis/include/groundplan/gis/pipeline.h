@@ -34,7 +34,8 @@ struct PipelineOptions {
   LodParams detail;                 // level of detail for simulation (issue 9); default: the exact union
   int threads = 0;                  // threads for every stage: --threads, NUM_THREADS=, GDAL_NUM_THREADS; 0 = all cores
   /// CityGML files are cut into chunks of about this many bytes, read side by side (issue 14): 0 = automatic
-  /// (about four chunks a thread, 2-64 MiB; never with one thread), < 0 = never. The result is the same either way.
+  /// (about four chunks a thread, 2-32 MiB; with one thread only a file over 64 MiB, so that each chunk is parsed in
+  /// memory, citygml.h dom_max_bytes), < 0 = never. The result is the same either way.
   std::int64_t read_chunk_bytes = 0;
   /// OGR sources are cut into ranges of about this many features, read side by side, one dataset handle each
   /// (issue 22, gis/ogr_ranges.h): 0 = automatic (about four ranges a thread, at least 20000 features; never with
@@ -52,6 +53,9 @@ struct ReadStats {
   /// CityGML files and OGR sources read whole although cutting was allowed, and why (small files are not listed;
   /// OGR sources are, where a flag or the driver rules ranges out).
   std::vector<std::pair<std::string, std::string>> read_whole;
+  /// CityGML files (some or all of them) streamed through expat instead of parsed in memory by pugixml (the
+  /// faster path, citygml.h dom_max_bytes), and why: too large, another encoding, a DOCTYPE, malformed XML ...
+  std::vector<std::pair<std::string, std::string>> xml_streamed;
 };
 
 struct StageTimings {
