@@ -138,10 +138,10 @@ if [ "$BIG_MB" != 0 ]; then
   rm -rf "$W/tiles" "$W"/*.gpkg "$W"/*.csv
   s=$(date +%s); python3 tests/bench/gen_big_citygml.py "$W/big.gml" "$BIG_MB" | tail -1; echo "  made in $(( $(date +%s) - s )) s"
   cat "$W/big.gml" > /dev/null
-  gp big_all -f GPKG "$W/big.gpkg" "$W/big.gml"
+  gp big_all -f GPKG "$W/big_all.gpkg" "$W/big.gml"
   if want xml; then
-    gp big_all_2 -f GPKG "$W/big.gpkg" "$W/big.gml"
-    gp big_expat -f GPKG "$W/big.gpkg" "$W/big.gml" --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
+    gp big_all_2 -f GPKG "$W/big_all_2.gpkg" "$W/big.gml"
+    gp big_expat -f GPKG "$W/big_expat.gpkg" "$W/big.gml" --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
   fi
 fi
 echo "== done"
