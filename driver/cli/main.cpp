@@ -556,6 +556,9 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   setup.dst = ogr.dst;
   setup.options = ogr.options;
   if (!ogr.layer_named) setup.options.push_back("ground_plans");
+  const std::vector<std::string> layers = ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+  const std::string nln = groundplan::cli::table_name(ogr.options, "");
+  for (const std::string& l : layers) setup.tables.push_back(layers.size() == 1 && !nln.empty() ? nln : l);
   if (root && r.footprints == 0) {
     if (!ogr.quiet) print_problems(r.problems);
     std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
