@@ -255,11 +255,11 @@ def test_nrw_like_tiles_over_4_ranks(tmp_path):
 GPKG_LAYERS = ["ground_plans", "plan_members", "problems"]
 
 
-def gpkg_run(tmp_path, name, src, ranks, *extra, env=None, check=True):
+def gpkg_run(tmp_path, name, src, ranks, *extra, env=None, check=True, layers=GPKG_LAYERS):
     out, stats = tmp_path / f"{name}.gpkg", tmp_path / f"{name}.json"
     p = subprocess.run([*mpirun(ranks), *(["-x", "GROUNDPLAN_MPI_TEST_FAIL"] if env else []), BIN, "-q", "--threads", "1", "--tiles", "on",
                         "--id-field", "bid", "--stats", str(stats), *extra, "-f", "GPKG", str(out), str(src),
-                        *GPKG_LAYERS], capture_output=True, text=True, env=env or gdal_env(), timeout=300)
+                        *layers], capture_output=True, text=True, env=env or gdal_env(), timeout=300)
     if check:
         assert p.returncode == 0, p.stderr
         return out, json.loads(stats.read_text())
@@ -328,6 +328,21 @@ def test_gpkg_by_ranks_on_the_real_niedersachsen_tiles_and_a_bad_one(tmp_path):
     assert stats["counts"]["problems"] >= 1
     same_gpkg(ranks, gathered)
     assert [p for p in plan_rows(ranks)[2] if p[2] == "UNREADABLE_FILE"]
+
+
+def test_gpkg_by_ranks_with_a_new_name(tmp_path, city):
+    """-nln names the plans table: the ranks' slices are appended to it."""
+    import sqlite3
+    from test_gpkg_writers import same_file_content
+    folder, _ = city
+    (tmp_path / "ranks").mkdir()
+    (tmp_path / "gathered").mkdir()
+    ranks, stats = gpkg_run(tmp_path / "ranks", "out", folder, 4, "-nln", "blocks", layers=["ground_plans"])
+    gathered, _ = gpkg_run(tmp_path / "gathered", "out", folder, 4, "-nln", "blocks", "-dim", "XY",
+                           layers=["ground_plans"])
+    assert stats["writer"]["writers"] == 4
+    same_file_content(ranks, gathered, ["blocks"])
+    assert sqlite3.connect(ranks).execute("SELECT count(*) FROM blocks").fetchone()[0] == COURTYARDS + 1
 
 
 def test_ranks_that_do_not_share_the_folder_let_rank_0_write(tmp_path, city):
