@@ -471,6 +471,24 @@ std::string tiles_ruled_out(const PipelineOptions& options, const Ogr2ogrArgs& o
   return {};
 }
 
+/// A tiled run without a footprint (every building a problem, or none at all): its problems and why nothing is
+/// written, as the one-process run says it.
+void say_nothing_usable(const groundplan::gis::TiledResult& r, const Ogr2ogrArgs& ogr) {
+  if (!ogr.quiet) print_problems(r.problems);
+  std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
+               r.buildings_read == 0
+                   ? "no building found"
+                   : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+}
+
+/// ogr2ogr's options without the layer names (they come last), and the layers written (ground_plans unless named).
+std::vector<std::string> option_flags(const Ogr2ogrArgs& ogr) {
+  return {ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size())};
+}
+std::vector<std::string> written_layers(const Ogr2ogrArgs& ogr) {
+  return ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+}
+
 /// --stats of a tiled run (one process or ranks): counts, timings, "tiles", "mpi". `plans`: in the whole dataset
 /// (rank 0 of a run whose ranks write their own plans holds none of theirs). False (said) when it cannot be written.
 bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::TiledResult& r, std::size_t plans,
@@ -556,15 +574,11 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   setup.dst = ogr.dst;
   setup.options = ogr.options;
   if (!ogr.layer_named) setup.options.push_back("ground_plans");
-  const std::vector<std::string> layers = ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
-  const std::string nln = groundplan::cli::table_name(ogr.options, "");
+  const std::vector<std::string> layers = written_layers(ogr);
+  const std::string nln = groundplan::cli::table_name(option_flags(ogr), "");
   for (const std::string& l : layers) setup.tables.push_back(layers.size() == 1 && !nln.empty() ? nln : l);
   if (root && r.footprints == 0) {
-    if (!ogr.quiet) print_problems(r.problems);
-    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-                 r.buildings_read == 0
-                     ? "no building found"
-                     : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+    say_nothing_usable(r, ogr);
     setup.create = false;
   }
   auto* mine = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
@@ -590,14 +604,6 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
 #endif
 
 #ifdef GROUNDPLAN_WITH_MPI
-/// ogr2ogr's options without the layer names (they come last), and the layers written (ground_plans unless named).
-std::vector<std::string> option_flags(const Ogr2ogrArgs& ogr) {
-  return {ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size())};
-}
-std::vector<std::string> written_layers(const Ogr2ogrArgs& ogr) {
-  return ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
-}
-
 /// Under mpirun into a file: why rank 0 writes every plan (gathered to it), rather than every rank its own into a
 /// GeoPackage slice (gpkg_rank_slices.h); empty: every rank writes. Collective, before the run (the ranks keep
 /// their plans or stream them). Rank 0 decides: a new local GeoPackage whose index the CLI packs, and ogr2ogr
@@ -672,11 +678,7 @@ int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& o
     const std::filesystem::path dst(w.dst);
     w.folder = dst.has_parent_path() ? dst.parent_path().string() : ".";
     if (r.footprints == 0) {
-      if (!ogr.quiet) print_problems(r.problems);
-      std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-                   r.buildings_read == 0
-                       ? "no building found"
-                       : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+      say_nothing_usable(r, ogr);
       w.nothing = true;
     }
   }
@@ -778,11 +780,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
                              groundplan::gis::process_cpu_seconds() - cpu0);
   };
   if (r.footprints == 0) {
-    if (!ogr.quiet) print_problems(r.problems);
-    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-                 r.buildings_read == 0
-                     ? "no building found"
-                     : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+    say_nothing_usable(r, ogr);
     stats(0, 0, nullptr);
     return finish(1);
   }
