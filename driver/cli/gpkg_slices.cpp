@@ -33,21 +33,10 @@ int per_feature_arity(const std::string& opt) {
   return -1;
 }
 
-std::string table_name(const std::vector<std::string>& flags, const std::string& plans_layer) {
-  std::string name = plans_layer;
-  for (std::size_t i = 0; i + 1 < flags.size(); ++i)
-    if (flags[i] == "-nln") name = flags[i + 1];
-  return name;
-}
-
-void remove_with_sidecars(const std::string& path) {
-  std::error_code ec;
-  for (const char* suffix : {"", "-journal", "-wal", "-shm"}) std::filesystem::remove(path + suffix, ec);
-}
-
-/// Appends the rows of the attached `part`'s table to the destination's (same schema, FIDs after the
-/// destination's) and widens the destination's extent.
-void append_part(const sqlite::Db& db, const std::string& part, const std::string& table) {
+/// Appends the rows of the attached `part`'s table with rowids in [first, last] (all of them where last < first)
+/// to the destination's (same schema, FIDs kept) and widens the destination's extent by the part's.
+void append_part(const sqlite::Db& db, const std::string& part, const std::string& table, std::int64_t first,
+                 std::int64_t last) {
   using sqlite::id;
   using sqlite::lit;
   auto columns = [&](const std::string& schema) {
@@ -59,7 +48,10 @@ void append_part(const sqlite::Db& db, const std::string& part, const std::strin
   const std::vector<std::string> dst_columns = columns("main");
   if (dst_columns.empty() || columns("part") != dst_columns)
     throw sqlite::Failure(part + ": the slice's table " + table + " is not the destination's");
-  db.exec("INSERT INTO main." + id(table) + " SELECT * FROM part." + id(table));
+  std::string rows = "INSERT INTO main." + id(table) + " SELECT * FROM part." + id(table);
+  // GeoPackage tables have an INTEGER PRIMARY KEY (the FID): rowid is that column whatever its name.
+  if (first <= last) rows += " WHERE rowid BETWEEN " + std::to_string(first) + " AND " + std::to_string(last);
+  db.exec(rows);
   // gpkg_contents: the extent of all slices (min/max skip the NULLs of a slice without geometry).
   std::string set;
   for (const char* c : {"min_x", "min_y", "max_x", "max_y"}) {
@@ -71,15 +63,17 @@ void append_part(const sqlite::Db& db, const std::string& part, const std::strin
   db.exec("UPDATE main.gpkg_contents SET " + set + " WHERE lower(table_name) = lower(" + lit(table) + ")");
 }
 
-/// Appends the parts to `dst` in order, a transaction each (SQLite detaches a database only outside one); the
-/// table's triggers (GDAL's feature-count triggers) are taken off while the rows go in and put back after, with
-/// the count set once. The caller removes `dst` when this throws.
-void merge(const std::string& dst, const std::vector<std::string>& parts, const std::string& table) {
+}  // namespace
+
+void append_runs(const std::string& dst, const std::vector<AppendRun>& runs) {
   using sqlite::id;
   using sqlite::lit;
   sqlite::Db db(dst);
+  std::vector<std::string> tables;
+  for (const AppendRun& r : runs)
+    if (std::find(tables.begin(), tables.end(), r.table) == tables.end()) tables.push_back(r.table);
   std::vector<std::array<std::string, 2>> triggers;
-  {
+  for (const std::string& table : tables) {
     sqlite::Stmt s(db, "SELECT name, sql FROM sqlite_master WHERE type = 'trigger' AND lower(tbl_name) = lower(" +
                            lit(table) + ")");
     while (s.row()) triggers.push_back({s.text(0), s.text(1)});
@@ -92,11 +86,11 @@ void merge(const std::string& dst, const std::vector<std::string>& parts, const 
   // The file is only handed over after the last commit, which syncs it; the appends need not each.
   db.exec("PRAGMA synchronous = OFF");
   for (const auto& t : triggers) db.exec("DROP TRIGGER " + id(t[0]));
-  for (const std::string& part : parts) {
-    db.exec("ATTACH DATABASE " + lit(part) + " AS part");
+  for (const AppendRun& run : runs) {
+    db.exec("ATTACH DATABASE " + lit(run.part) + " AS part");
     try {
       db.exec("BEGIN");
-      append_part(db, part, table);
+      append_part(db, run.part, run.table, run.first, run.last);
       db.exec("COMMIT");
     } catch (...) {
       db.exec("ROLLBACK");
@@ -108,13 +102,37 @@ void merge(const std::string& dst, const std::vector<std::string>& parts, const 
   db.exec("PRAGMA synchronous = FULL");
   db.exec("BEGIN");
   if (has_ogr_contents)
-    db.exec("UPDATE gpkg_ogr_contents SET feature_count = (SELECT count(*) FROM " + id(table) +
-            ") WHERE lower(table_name) = lower(" + lit(table) + ")");
+    for (const std::string& table : tables)
+      db.exec("UPDATE gpkg_ogr_contents SET feature_count = (SELECT count(*) FROM " + id(table) +
+              ") WHERE lower(table_name) = lower(" + lit(table) + ")");
   for (const auto& t : triggers) db.exec(t[1]);
   db.exec("COMMIT");
 }
 
-}  // namespace
+void remove_with_sidecars(const std::string& path) {
+  std::error_code ec;
+  for (const char* suffix : {"", "-journal", "-wal", "-shm"}) std::filesystem::remove(path + suffix, ec);
+}
+
+std::string table_name(const std::vector<std::string>& flags, const std::string& plans_layer) {
+  std::string name = plans_layer;
+  for (std::size_t i = 0; i + 1 < flags.size(); ++i)
+    if (flags[i] == "-nln") name = flags[i + 1];
+  return name;
+}
+
+std::string slices_ruled_out(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
+                             const std::string& plans_layer) {
+  if (std::none_of(layers.begin(), layers.end(), [&](const std::string& l) { return EQUAL(l.c_str(), plans_layer.c_str()); }))
+    return "the " + plans_layer + " layer is not written";
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    const int n = per_feature_arity(flags[i]);
+    if (n < 0) return "ogr2ogr option " + flags[i];
+    if (flags[i] == "-nln" && layers.size() > 1) return "-nln with several layers";
+    i += static_cast<std::size_t>(n);
+  }
+  return {};
+}
 
 void sqlite_without_memory_statistics() { sqlite3_config(SQLITE_CONFIG_MEMSTATUS, 0); }
 
@@ -128,14 +146,8 @@ int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::s
   const int writers = std::min(threads, by_plans);
   if (writers < 2)
     return one(threads < 2 ? "one thread" : "fewer than " + std::to_string(2 * kPlansPerWriter) + " plans");
-  if (std::none_of(layers.begin(), layers.end(), [&](const std::string& l) { return EQUAL(l.c_str(), plans_layer.c_str()); }))
-    return one("the " + plans_layer + " layer is not written");
-  for (std::size_t i = 0; i < flags.size(); ++i) {
-    const int n = per_feature_arity(flags[i]);
-    if (n < 0) return one("ogr2ogr option " + flags[i]);
-    if (flags[i] == "-nln" && layers.size() > 1) return one("-nln with several layers");
-    i += static_cast<std::size_t>(n);
-  }
+  std::string why = slices_ruled_out(flags, layers, plans_layer);
+  if (!why.empty()) return one(std::move(why));
   return writers;
 }
 
@@ -191,7 +203,9 @@ SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, c
 
   const auto t1 = clock::now();
   try {
-    merge(w.dst, parts, table_name(w.flags, w.plans_layer));
+    std::vector<AppendRun> runs;
+    for (const std::string& p : parts) runs.push_back({p, table_name(w.flags, w.plans_layer)});
+    append_runs(w.dst, runs);
   } catch (const std::exception& e) {
     return fail(std::string("appending the slices failed: ") + e.what());
   }

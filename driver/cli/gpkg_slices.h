@@ -14,6 +14,7 @@
 #include <gdal.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -30,6 +31,32 @@ void sqlite_without_memory_statistics();
 /// -explodecollections ...). `flags`: the ogr2ogr options without the layer names.
 int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
                  const std::string& plans_layer, std::size_t plans, int threads, std::string* why_one);
+
+/// Why the plans layer cannot be written in slices (empty: it can): the layer is not written, an ogr2ogr option
+/// whose effect spans features, -nln with several layers. Used by gpkg_writers and by the MPI ranks
+/// (gpkg_rank_slices.h).
+std::string slices_ruled_out(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
+                             const std::string& plans_layer);
+
+/// The plans layer's table name: `plans_layer`, or what -nln says.
+std::string table_name(const std::vector<std::string>& flags, const std::string& plans_layer);
+
+/// Removes a SQLite file and its journal files (nothing said when they are not there).
+void remove_with_sidecars(const std::string& path);
+
+/// Rows of one table of a slice file to append to the destination: those with FIDs (rowids) first..last, or all
+/// of them where last < first.
+struct AppendRun {
+  std::string part;   // the slice file
+  std::string table;  // the same table in both files
+  std::int64_t first = 0, last = -1;
+};
+
+/// Appends the runs to the GeoPackage `dst` in the order given, one transaction each (SQLite copies the records;
+/// FIDs are kept, so a run may go before rows already there); the tables' triggers (GDAL's feature-count triggers)
+/// are taken off while the rows go in and put back after, each table's feature count and extent (gpkg_contents:
+/// the slices' extents) set once. Throws sqlite::Failure; the caller removes `dst` then.
+void append_runs(const std::string& dst, const std::vector<AppendRun>& runs);
 
 /// A dataset whose plans layer serves the plans [first, last) only (and the other layers whole); the callee
 /// closes it with GDALClose.

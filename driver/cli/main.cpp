@@ -8,6 +8,7 @@
 #include "gpkg_slices.h"
 #include "preview.h"
 #ifdef GROUNDPLAN_WITH_MPI
+#include "gpkg_rank_slices.h"
 #include "mpi_exchange.h"
 #include "rank_writes.h"
 #include "staged_output.h"
@@ -473,6 +474,24 @@ std::string tiles_ruled_out(const PipelineOptions& options, const Ogr2ogrArgs& o
   return {};
 }
 
+/// A tiled run without a footprint (every building a problem, or none at all): its problems and why nothing is
+/// written, as the one-process run says it.
+void say_nothing_usable(const groundplan::gis::TiledResult& r, const Ogr2ogrArgs& ogr) {
+  if (!ogr.quiet) print_problems(r.problems);
+  std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
+               r.buildings_read == 0
+                   ? "no building found"
+                   : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+}
+
+/// ogr2ogr's options without the layer names (they come last), and the layers written (ground_plans unless named).
+std::vector<std::string> option_flags(const Ogr2ogrArgs& ogr) {
+  return {ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size())};
+}
+std::vector<std::string> written_layers(const Ogr2ogrArgs& ogr) {
+  return ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+}
+
 /// --stats of a tiled run (one process or ranks): counts, timings, "tiles", "mpi". `plans`: in the whole dataset
 /// (rank 0 of a run whose ranks write their own plans holds none of theirs). False (said) when it cannot be written.
 bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::TiledResult& r, std::size_t plans,
@@ -558,12 +577,11 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   setup.dst = ogr.dst;
   setup.options = ogr.options;
   if (!ogr.layer_named) setup.options.push_back("ground_plans");
+  const std::vector<std::string> layers = written_layers(ogr);
+  const std::string nln = groundplan::cli::table_name(option_flags(ogr), "");
+  for (const std::string& l : layers) setup.tables.push_back(layers.size() == 1 && !nln.empty() ? nln : l);
   if (root && r.footprints == 0) {
-    if (!ogr.quiet) print_problems(r.problems);
-    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-                 r.buildings_read == 0
-                     ? "no building found"
-                     : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+    say_nothing_usable(r, ogr);
     setup.create = false;
   }
   auto* mine = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
@@ -588,6 +606,135 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
 }
 #endif
 
+#ifdef GROUNDPLAN_WITH_MPI
+/// Under mpirun into a file: why rank 0 writes every plan (gathered to it), rather than every rank its own into a
+/// GeoPackage slice (gpkg_rank_slices.h); empty: every rank writes. Collective, before the run (the ranks keep
+/// their plans or stream them). Rank 0 decides: a new local GeoPackage whose index the CLI packs, and ogr2ogr
+/// options that act on each feature alone (gpkg_slices.h slices_ruled_out); then it leaves a file with a token
+/// beside the destination, which every rank must read back: the slices go into that folder, so a rank on a host
+/// that does not share it (no shared file system) would write where rank 0 cannot read.
+std::string why_rank_0_writes(const Ogr2ogrArgs& ogr, Ranks& ranks) {
+  namespace fs = std::filesystem;
+  std::string said, marker;
+  if (ranks.rank() == 0) {
+    std::string why = packs_gpkg_index(ogr) ? groundplan::cli::slices_ruled_out(option_flags(ogr), written_layers(ogr),
+                                                                                "ground_plans")
+                                            : "not a new local GeoPackage whose spatial index the CLI packs";
+    std::string token;
+    if (why.empty()) {
+      const fs::path dst(ogr.dst);
+      marker = ((dst.has_parent_path() ? dst.parent_path() : fs::path(".")) /
+                (".groundplan-shared-" + std::to_string(::getpid())))
+                   .string();
+      token = std::to_string(::getpid()) + "-" + std::to_string(clock::now().time_since_epoch().count());
+      std::ofstream f(marker);
+      f << token;
+      f.close();
+      if (!f) why = "cannot write beside " + ogr.dst;
+    }
+    said = why.empty() ? marker + "\n" + token : "!" + why;
+  }
+  said = ranks.broadcast(said);
+  int sees = 1;
+  if (ranks.rank() != 0 && !said.empty() && said[0] != '!') {
+    const std::size_t nl = said.find('\n');
+    std::ifstream f(said.substr(0, nl));
+    std::string got;
+    std::getline(f, got);
+    sees = f.is_open() && got == said.substr(nl + 1) && !ranks.test_pretends("shared");
+  }
+  const std::vector<int> all = ranks.every_rank(sees);
+  if (!marker.empty()) {
+    std::error_code ec;
+    fs::remove(marker, ec);
+  }
+  if (said.empty() || said[0] == '!') return said.empty() ? std::string("rank 0 said nothing") : said.substr(1);
+  std::string blind;
+  for (std::size_t r = 0; r < all.size(); ++r)
+    if (!all[r]) blind += (blind.empty() ? "" : ", ") + std::to_string(r);
+  if (!blind.empty())
+    return "the destination's folder is not seen by rank " + blind + " (not a file system every rank shares)";
+  return {};
+}
+
+/// The tiled run over ranks into a new GeoPackage (gpkg_rank_slices.h): every rank writes its own final plans into a
+/// slice beside rank 0's staged destination, side by side; rank 0 appends the slices in FID order, packs the
+/// spatial index, and moves the file into place once every rank has finished.
+int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std::string& stats_path,
+                            const groundplan::Progress& progress, Ranks& ranks) {
+  const double cpu0 = groundplan::gis::process_cpu_seconds();
+  const auto t0 = clock::now();
+  const bool root = ranks.rank() == 0;
+  std::shared_ptr<const groundplan::gis::TiledResult> result = groundplan::gis::run_pipeline_tiled(
+      options, ranks, root ? progress : groundplan::Progress{}, groundplan::gis::FinalPlans::kept_by_each_rank);
+  const groundplan::gis::TiledResult& r = *result;
+  const std::size_t plans = r.tiles.final_plans + r.tiles.reduced_plans;  // rank 0: over all ranks
+  std::unique_ptr<groundplan::cli::StagedOutput> staged;
+  groundplan::cli::RankGpkgWrite w;
+  w.flags = option_flags(ogr);
+  w.flags.insert(w.flags.end(), {"-lco", "SPATIAL_INDEX=NO"});  // packed once the slices are in (gpkg_rtree.h)
+  w.layers = written_layers(ogr);
+  w.progress = ogr.progress && !ogr.quiet;
+  if (root) {
+    staged = std::make_unique<groundplan::cli::StagedOutput>(ogr.dst);
+    w.dst = staged->path();
+    const std::filesystem::path dst(w.dst);
+    w.folder = dst.has_parent_path() ? dst.parent_path().string() : ".";
+    if (r.footprints == 0) {
+      say_nothing_usable(r, ogr);
+      w.nothing = true;
+    }
+  }
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
+  const auto t_write = clock::now();
+  const groundplan::cli::RankGpkgOutcome o = groundplan::cli::write_gpkg_from_every_rank(
+      ranks, w, r,
+      [&] {
+        return GDALDataset::ToHandle(new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, 0, options.threads));
+      },
+      vector_translate, [&ranks] { ranks.test_point("slice"); });
+  if (!root) {
+    ranks.barrier();  // rank 0 has appended the slices
+    return 0;
+  }
+  // Every rank waits for rank 0 here before the dataset is moved into place; rank 0's outcome is its return code.
+  auto finish = [&](int rc) {
+    ranks.barrier();
+    if (rc == 0) staged->commit();
+    return rc;
+  };
+  auto stats = [&](std::size_t n, double write_s, double index_s, const WriteOutcome* written) {
+    return write_tiled_stats(stats_path, r, n, write_s, index_s, written, seconds_since(t0),
+                             groundplan::gis::process_cpu_seconds() - cpu0);
+  };
+  if (o.nothing) {
+    stats(0, 0, 0, nullptr);
+    return finish(1);
+  }
+  if (!o.ok) {
+    std::fprintf(stderr, "groundplan: could not write %s%s: %s\n", ogr.dst.c_str(),
+                 o.usage_error ? " (bad ogr2ogr options)" : "", o.why.c_str());
+    return finish(1);
+  }
+  WriteOutcome wo;
+  wo.ok = wo.own_index = true;
+  const auto t_index = clock::now();
+  const bool indexed = groundplan::cli::index_new_gpkg(
+      w.dst, static_cast<int>(groundplan::gis::thread_count(options.threads)), wo.built);
+  if (wo.built.by_gdal)
+    std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL built it instead\n",
+                 wo.built.error.c_str());
+  if (!indexed) std::fprintf(stderr, "groundplan: warning: %s has no spatial index\n", ogr.dst.c_str());
+  wo.index_s = seconds_since(t_index);
+  wo.write_s = seconds_since(t_write);
+  wo.writer = {{"writers", ranks.size()}, {"by", "every rank, a slice each"}, {"slice_s", o.slice_s},
+               {"append_s", o.append_s}};
+  const int rc = finish(stats(plans, wo.write_s, wo.index_s, &wo) ? 0 : 1);
+  if (!ogr.quiet) print_tiled_summary(r, ogr, ogr.dst, plans, seconds_since(t0), wo.write_s);
+  return rc;
+}
+#endif
+
 /// The tiled run (issue 15, gis/tiled.h): same plans with bounded memory; the final plans of all tiles first,
 /// then the plans from seams. --stats says how many were final at once and how many were seams.
 int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const std::string& stats_path,
@@ -597,13 +744,19 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   std::shared_ptr<const groundplan::gis::TiledResult> result;
   Ogr2ogrArgs ogr = ogr_in;
 #ifdef GROUNDPLAN_WITH_MPI
-  // Over ranks (issue 15): rank 0 gets every plan and writes the one dataset, into a staging folder that is moved
-  // into place once every rank has finished (staged_output.h); the others only map and reduce.
+  // Over ranks (issue 15): the dataset is written into a staging folder that is moved into place once every rank
+  // has finished (staged_output.h). A database: every rank writes its own plans (stage 5); a new GeoPackage: every
+  // rank writes a slice (below); other files: rank 0 gets every plan and writes them all, the others only map and
+  // reduce.
   std::unique_ptr<groundplan::cli::StagedOutput> staged;
-  // A database: every rank writes its own plans (stage 5); files: rank 0 writes them all.
   if (rank_count(ranks) > 1 && groundplan::cli::written_by_every_rank(ogr.format, ogr.dst))
     return run_tiled_into_database(options, ogr, stats_path, progress, *ranks);
+  // A new GeoPackage: every rank writes its own plans into a slice, rank 0 joins them (gpkg_rank_slices.h), unless
+  // an option spans features or the ranks do not share the destination's folder (--stats "writer" says why).
+  std::string rank_0_writes;
   if (rank_count(ranks) > 1) {
+    rank_0_writes = why_rank_0_writes(ogr, *ranks);
+    if (rank_0_writes.empty()) return run_tiled_gpkg_by_ranks(options, ogr, stats_path, progress, *ranks);
     result = groundplan::gis::run_pipeline_tiled(options, *ranks, ranks->rank() == 0 ? progress : groundplan::Progress{});
     if (ranks->rank() != 0) {
       ranks->barrier();  // rank 0 has written
@@ -630,11 +783,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
                              groundplan::gis::process_cpu_seconds() - cpu0);
   };
   if (r.footprints == 0) {
-    if (!ogr.quiet) print_problems(r.problems);
-    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-                 r.buildings_read == 0
-                     ? "no building found"
-                     : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+    say_nothing_usable(r, ogr);
     stats(0, 0, nullptr);
     return finish(1);
   }
@@ -642,9 +791,12 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, options.threads);
   // Plans are read back from the run's spill by position: datasets side by side may read it at once.
-  const WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
+  WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
     return new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, threads);
   });
+#ifdef GROUNDPLAN_WITH_MPI
+  if (rank_count(ranks) > 1) w.writer["rank_0_writes_every_plan"] = rank_0_writes;
+#endif
   if (!w.ok) {
     std::fprintf(stderr, "groundplan: could not write %s%s\n", ogr_in.dst.c_str(),
                  w.usage_error ? " (bad ogr2ogr options)" : "");

@@ -56,6 +56,21 @@ void MpiExchange::barrier() {
   check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
 }
 
+std::string MpiExchange::broadcast(const std::string& text) {
+  if (text.size() > static_cast<std::size_t>(1) << 30) throw Error("MPI broadcast: over 1 GiB");
+  int n = static_cast<int>(text.size());
+  check(MPI_Bcast(&n, 1, MPI_INT, 0, MPI_COMM_WORLD), "MPI_Bcast");
+  std::string out = rank_ == 0 ? text : std::string(static_cast<std::size_t>(n), '\0');
+  check(MPI_Bcast(out.data(), n, MPI_CHAR, 0, MPI_COMM_WORLD), "MPI_Bcast");
+  return out;
+}
+
+std::vector<int> MpiExchange::every_rank(int mine) {
+  std::vector<int> all(static_cast<std::size_t>(size_));
+  check(MPI_Allgather(&mine, 1, MPI_INT, all.data(), 1, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
+  return all;
+}
+
 void MpiExchange::abort(const std::string& why, int code) {
   std::fprintf(stderr, "groundplan: rank %d of %d: %s; aborting every rank of the run (nothing is written)\n", rank_,
                size_, why.c_str());
@@ -66,8 +81,9 @@ void MpiExchange::abort(const std::string& why, int code) {
 
 // A test hook (tests/e2e/test_mpi.py, test_postgis.py): GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW makes rank RANK fail at
 // its second allgather (after the map), with HOW ending in "@end" at the final barrier (rank 0 has written then),
-// with "@commit" where a rank writing into a database has written its rows but not committed them (test_point):
-// HOW = throw (an exception, as a failing rank) or kill (SIGKILL, as a dead one).
+// with "@commit" where a rank writing into a database has written its rows but not committed them, with "@slice"
+// where a rank has written its GeoPackage slice (test_point): HOW = throw (an exception, as a failing rank) or kill
+// (SIGKILL, as a dead one). HOW = pretend is no failure: test_pretends(POINT) is true on that rank.
 void MpiExchange::test_failure(const std::string& point) {
   if (point.empty() && ++calls_ != 2) return;
   const char* v = std::getenv("GROUNDPLAN_MPI_TEST_FAIL");
@@ -84,6 +100,15 @@ void MpiExchange::test_failure(const std::string& point) {
 }
 
 void MpiExchange::test_point(const std::string& point) { test_failure(point); }
+
+bool MpiExchange::test_pretends(const std::string& point) const {
+  const char* v = std::getenv("GROUNDPLAN_MPI_TEST_FAIL");
+  if (!v) return false;
+  const std::string s(v);
+  const std::size_t colon = s.find(':');
+  return colon != std::string::npos && std::atoi(s.substr(0, colon).c_str()) == rank_ &&
+         s.substr(colon + 1) == "pretend@" + point;
+}
 
 std::vector<char> MpiExchange::allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes) {
   test_failure("");

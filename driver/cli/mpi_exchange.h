@@ -21,12 +21,20 @@ class MpiExchange final : public gis::TileExchange {
   std::vector<char> allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes = nullptr) override;
   void send(int to, const std::vector<char>& bytes) override;
   std::vector<char> receive(int from) override;
+  /// Rank 0's `text` on every rank (collective). A step of the CLI's own before the tiled run: unlike allgather,
+  /// not counted by GROUNDPLAN_MPI_TEST_FAIL (whose plain form fails at the run's second allgather).
+  std::string broadcast(const std::string& text);
+  /// Every rank's `mine`, in rank order (collective; not counted by the test hook either).
+  std::vector<int> every_rank(int mine);
   /// Waits for every rank (collective).
   void barrier();
   /// Ends every rank of the job at once (MPI_Abort), after saying why on stderr. Does not return.
   [[noreturn]] void abort(const std::string& why, int code = 1);
   /// A named point where GROUNDPLAN_MPI_TEST_FAIL=RANK:HOW@POINT makes this rank fail (tests only; see the .cpp).
   void test_point(const std::string& point);
+  /// True where GROUNDPLAN_MPI_TEST_FAIL=RANK:pretend@POINT names this rank and `point` (tests only): a condition a
+  /// test on one host cannot make otherwise (point "shared": this rank does not see the destination's folder).
+  bool test_pretends(const std::string& point) const;
 
  private:
   int rank_ = 0, size_ = 1;

@@ -4,9 +4,11 @@
 #include <cpl_error.h>
 #include <cpl_string.h>
 #include <gdal_utils.h>
+#include <ogrsf_frmts.h>
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <set>
 
 namespace groundplan::cli {
@@ -104,6 +106,51 @@ bool wait_for_locks_at_most(GDALDatasetH dst, const char* timeout) {
   return CPLGetLastErrorType() < CE_Failure;
 }
 
+/// Which of `tables` exist in the datasource `dst` (names as GDAL gives them); nullopt when it cannot be opened.
+std::optional<std::vector<std::string>> existing_tables(const std::string& dst, const CPLStringList& doo,
+                                                        const std::vector<std::string>& tables, bool update) {
+  const char* const drivers[] = {"PostgreSQL", nullptr};
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  GDALDataset* ds = GDALDataset::FromHandle(
+      GDALOpenEx(dst.c_str(), GDAL_OF_VECTOR | (update ? GDAL_OF_UPDATE : 0), drivers, doo.List(), nullptr));
+  std::optional<std::vector<std::string>> out;
+  if (ds) {
+    out.emplace();
+    for (const std::string& t : tables)
+      if (OGRLayer* l = ds->GetLayerByName(t.c_str())) out->push_back(l->GetName());
+    GDALClose(GDALDataset::ToHandle(ds));
+  }
+  CPLPopErrorHandler();
+  return out;
+}
+
+/// Drops the tables of `tables` that exist now but were not in `before` (made by this run); what it dropped.
+std::vector<std::string> drop_made_tables(const std::string& dst, const CPLStringList& doo,
+                                          const std::vector<std::string>& tables,
+                                          const std::vector<std::string>& before) {
+  std::vector<std::string> dropped;
+  const char* const drivers[] = {"PostgreSQL", nullptr};
+  GDALDataset* ds = GDALDataset::FromHandle(
+      GDALOpenEx(dst.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, drivers, doo.List(), nullptr));
+  if (!ds) return dropped;
+  for (const std::string& t : tables) {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRLayer* l = ds->GetLayerByName(t.c_str());
+    CPLPopErrorHandler();
+    if (!l) continue;
+    const std::string name = l->GetName();
+    if (std::any_of(before.begin(), before.end(), [&](const std::string& b) { return EQUAL(b.c_str(), name.c_str()); }))
+      continue;
+    for (int i = 0; i < ds->GetLayerCount(); ++i)
+      if (ds->GetLayer(i) == l) {
+        if (ds->DeleteLayer(i) == OGRERR_NONE) dropped.push_back(name);
+        break;
+      }
+  }
+  GDALClose(GDALDataset::ToHandle(ds));
+  return dropped;
+}
+
 /// The -doo NAME=VALUE open options among the user's options.
 CPLStringList open_options(const std::vector<std::string>& options) {
   CPLStringList out;
@@ -147,23 +194,34 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   const auto t0 = std::chrono::steady_clock::now();
   RankWrite w;
 
-  // 1. Rank 0 makes the tables (with the user's options: -overwrite, -lco ...); the others wait for its word.
+  // 1. Rank 0 makes the tables (with the user's options: -overwrite, -lco ...); the others wait for its word. It
+  // notes which of them were there before: on failure it drops the others (made by this run) again.
+  const CPLStringList doo = open_options(setup.options);
   std::string created;
+  std::optional<std::vector<std::string>> before;
+  if (ex.rank() == 0 && setup.create) before = existing_tables(setup.dst, doo, setup.tables, false);
   if (ex.rank() == 0)
     created = !setup.create ? std::string("nothing to write")
                             : translate(setup.dst, nullptr, empty_layers, setup.options);
   GDALClose(GDALDataset::ToHandle(empty_layers));
+  // Only a datasource seen before the run tells what it made; one that could not be opened is left alone.
+  auto drop_made = [&] {
+    if (before) w.dropped = drop_made_tables(setup.dst, doo, setup.tables, *before);
+    std::string list;
+    for (const std::string& t : w.dropped) list += (list.empty() ? "" : ", ") + t;
+    return list.empty() ? std::string() : "; the tables this run made are dropped: " + list;
+  };
   const std::string not_created = gather_text(ex, created).at(0);
   if (!not_created.empty()) {
     GDALClose(GDALDataset::ToHandle(mine));
     w.why = "rank 0 could not create the tables: " + not_created;
+    if (ex.rank() == 0 && setup.create) w.why += drop_made();
     w.write_s = seconds_since(t0);
     return w;
   }
 
   // 2. Every rank adds its share in one transaction of its own, not committed yet.
   std::string wrote;
-  const CPLStringList doo = open_options(setup.options);
   const char* const drivers[] = {"PostgreSQL", nullptr};
   CPLErrorReset();
   GDALDatasetH dst = GDALOpenEx(setup.dst.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE | GDAL_OF_VERBOSE_ERROR, drivers,
@@ -181,7 +239,12 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     wrote = translate(setup.dst, GDALDataset::ToHandle(&held), mine, append_options(setup.options));
   }
   GDALClose(GDALDataset::ToHandle(mine));
-  if (before_commit) before_commit();
+  // A rank that throws here (a fault, or the test hook) is a rank that failed to write: every rank rolls back.
+  try {
+    if (before_commit) before_commit();
+  } catch (const std::exception& e) {
+    if (wrote.empty()) wrote = e.what();
+  }
 
   // 3. Commit only once every rank has written all of its rows; otherwise every rank rolls back.
   const std::string not_written = failures(gather_text(ex, wrote));
@@ -200,10 +263,12 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   w.write_s = seconds_since(t0);
   if (!not_written.empty()) {
     w.why = not_written + " (every rank rolled back: none of this run's rows are in the tables)";
+    if (ex.rank() == 0) w.why += drop_made();
     return w;
   }
   if (!not_committed.empty()) {
     w.why = not_committed + " (the other ranks' rows are committed: the tables are incomplete)";
+    if (ex.rank() == 0) w.why += drop_made();
     return w;
   }
   w.ok = true;

@@ -33,20 +33,25 @@ struct TableSetup {
   std::string dst;                   // the PG: datasource
   std::vector<std::string> options;  // the user's ogr2ogr options and layer names, as for one process
   bool create = true;                // false: rank 0 has nothing to write (says so itself); every rank stops
+  std::vector<std::string> tables;   // the tables the run writes (the layers' names, or -nln's): those of them
+                                     // that did not exist before are dropped again when the run fails
 };
 
 /// The outcome of a write by every rank.
 struct RankWrite {
   bool ok = false;     // every rank wrote and committed
   std::string why;     // otherwise: what failed, on which rank (rank 0 has the whole story)
+  std::vector<std::string> dropped;  // rank 0, on failure: the tables this run had made and dropped again
   double write_s = 0;  // this rank: creating (rank 0) + appending + committing
 };
 
 /// Collective over `ex`: rank 0 creates the tables from `empty_layers` (the layers of `mine` without features,
 /// in the working CRS), every rank appends the layers of `mine` (its share) in a transaction of its own and commits
 /// once every rank has written. Both datasets are taken (closed here). `before_commit` (a test hook) runs after
-/// this rank's rows are written, before the outcome is exchanged. A write that fails does not throw: every rank
-/// learns it and every transaction is rolled back; MPI failures throw.
+/// this rank's rows are written, before the outcome is exchanged. A write that fails or throws does not throw:
+/// every rank learns it, every transaction is rolled back (or, where a commit failed, the others' rows stay), and
+/// rank 0 then drops the tables of `setup.tables` that it made in this run (none that existed before); MPI
+/// failures throw (mpirun ends the job: PostgreSQL rolls back, but the tables made stay).
 RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, GDALDataset* mine,
                                 GDALDataset* empty_layers, const std::function<void()>& before_commit);
 

@@ -246,3 +246,137 @@ def test_nrw_like_tiles_over_4_ranks(tmp_path):
     assert got[3]["counts"]["footprints"] == buildings
     assert got[3]["tiles"]["seam_plans"] > 0
     check_plans(got, got[3], 4, tiles)
+
+
+# A new GeoPackage under mpirun (driver/cli/gpkg_rank_slices.h): every rank writes its own final plans into a slice
+# beside rank 0's staged destination, and rank 0 appends the slices in FID order. The file must be the one rank 0
+# writes when it gathers every plan (forced here by -dim XY, an option that changes nothing in these 2D plans but
+# keeps one writer), in every respect test_gpkg_writers.py compares; and as sets, the plans of one process.
+GPKG_LAYERS = ["ground_plans", "plan_members", "problems"]
+
+
+def gpkg_run(tmp_path, name, src, ranks, *extra, env=None, check=True, layers=GPKG_LAYERS):
+    out, stats = tmp_path / f"{name}.gpkg", tmp_path / f"{name}.json"
+    p = subprocess.run([*mpirun(ranks), *(["-x", "GROUNDPLAN_MPI_TEST_FAIL"] if env else []), BIN, "-q", "--threads", "1", "--tiles", "on",
+                        "--id-field", "bid", "--stats", str(stats), *extra, "-f", "GPKG", str(out), str(src),
+                        *layers], capture_output=True, text=True, env=env or gdal_env(), timeout=300)
+    if check:
+        assert p.returncode == 0, p.stderr
+        return out, json.loads(stats.read_text())
+    return p
+
+
+def same_gpkg(a, b):
+    """test_gpkg_writers.py's comparison; a table without rows (GDAL leaves its feature_count NULL, which that
+    comparison's count check does not take) is compared here: schema and gpkg_contents there, no row in either."""
+    import sqlite3
+    from test_gpkg_writers import same_file_content
+    empty = [t for t in GPKG_LAYERS if sqlite3.connect(b).execute(f'SELECT count(*) FROM "{t}"').fetchone()[0] == 0]
+    for t in empty:
+        assert list(sqlite3.connect(a).execute(f'SELECT * FROM "{t}"')) == [], t
+    same_file_content(a, b, [t for t in GPKG_LAYERS if t not in empty])
+
+
+def plan_rows(path):
+    import sqlite3
+    db = sqlite3.connect(path)
+    return (sorted(db.execute("SELECT n_parts, area_m2, min_z, max_z, building_ids FROM ground_plans")),
+            sorted(db.execute("SELECT fp_id, source_id FROM plan_members")),
+            sorted(db.execute("SELECT source_id, stage, code, reason FROM problems")))
+
+
+def test_gpkg_written_by_every_rank_is_the_gathered_file(tmp_path, city):
+    import sqlite3
+    folder, _ = city
+    (tmp_path / "ranks").mkdir()
+    (tmp_path / "gathered").mkdir()
+    ranks, stats = gpkg_run(tmp_path / "ranks", "out", folder, 4)
+    gathered, g_stats = gpkg_run(tmp_path / "gathered", "out", folder, 4, "-dim", "XY")
+    w = stats["writer"]
+    assert w["writers"] == 4 and w["by"] == "every rank, a slice each", w
+    assert g_stats["writer"]["rank_0_writes_every_plan"] == "ogr2ogr option -dim", g_stats["writer"]
+    plans = stats["counts"]["ground_plans"]
+    assert plans == COURTYARDS + 1 == g_stats["counts"]["ground_plans"]
+    assert stats["tiles"]["seam_plans"] > 0
+    same_gpkg(ranks, gathered)
+    db = sqlite3.connect(ranks)
+    assert db.execute("SELECT count(*) FROM ground_plans").fetchone()[0] == plans
+    assert db.execute("SELECT count(*) FROM plan_members").fetchone()[0] == stats["counts"]["footprints"]
+    assert db.execute("SELECT count(*) FROM rtree_ground_plans_geom").fetchone()[0] == plans
+    assert db.execute("SELECT rtreecheck('rtree_ground_plans_geom')").fetchone()[0] == "ok"
+    assert sorted(os.listdir(tmp_path / "ranks")) == ["out.gpkg", "out.json"], "a slice or a marker was left behind"
+    # as sets, the plans, members and problems of one process
+    (tmp_path / "one").mkdir()
+    run([BIN, "-q", "--tiles", "off", "--id-field", "bid", "-f", "GPKG", tmp_path / "one" / "out.gpkg", folder,
+         *GPKG_LAYERS])
+    assert plan_rows(ranks) == plan_rows(tmp_path / "one" / "out.gpkg")
+
+
+def test_gpkg_by_ranks_on_the_real_niedersachsen_tiles_and_a_bad_one(tmp_path):
+    """Real tiles and ids, 3 ranks for 5 tiles, the last one broken: its problem (rank 2's) is in rank 0's layer."""
+    folder = tmp_path / "tiles"
+    folder.mkdir()
+    for tile in sorted(NIEDERSACHSEN.glob("*.gml")):
+        (folder / tile.name).symlink_to(tile)
+    (folder / "LoD1_99999999_broken.gml").write_text('<?xml version="1.0"?>\n<CityModel><cityObjectMember><bldg')
+    (tmp_path / "ranks").mkdir()
+    (tmp_path / "gathered").mkdir()
+    ranks, stats = gpkg_run(tmp_path / "ranks", "out", folder, 3)
+    gathered, _ = gpkg_run(tmp_path / "gathered", "out", folder, 3, "-dim", "XY")
+    assert stats["writer"]["writers"] == 3
+    assert stats["counts"]["ground_plans"] > 100
+    assert stats["counts"]["problems"] >= 1
+    same_gpkg(ranks, gathered)
+    assert [p for p in plan_rows(ranks)[2] if p[2] == "UNREADABLE_FILE"]
+
+
+def test_gpkg_by_ranks_with_a_new_name(tmp_path, city):
+    """-nln names the plans table: the ranks' slices are appended to it."""
+    import sqlite3
+    from test_gpkg_writers import same_file_content
+    folder, _ = city
+    (tmp_path / "ranks").mkdir()
+    (tmp_path / "gathered").mkdir()
+    ranks, stats = gpkg_run(tmp_path / "ranks", "out", folder, 4, "-nln", "blocks", layers=["ground_plans"])
+    gathered, _ = gpkg_run(tmp_path / "gathered", "out", folder, 4, "-nln", "blocks", "-dim", "XY",
+                           layers=["ground_plans"])
+    assert stats["writer"]["writers"] == 4
+    same_file_content(ranks, gathered, ["blocks"])
+    assert sqlite3.connect(ranks).execute("SELECT count(*) FROM blocks").fetchone()[0] == COURTYARDS + 1
+
+
+def test_ranks_that_do_not_share_the_folder_let_rank_0_write(tmp_path, city):
+    """A rank that does not see the destination's folder (no shared file system: pretended by the test hook, as one
+    host cannot make it) could not hand rank 0 its slice: rank 0 gathers every plan and writes them, as --stats
+    says; the file is the gathered one."""
+    folder, _ = city
+    env = gdal_env()
+    env["GROUNDPLAN_MPI_TEST_FAIL"] = "2:pretend@shared"
+    (tmp_path / "blind").mkdir()
+    (tmp_path / "gathered").mkdir()
+    got, stats = gpkg_run(tmp_path / "blind", "out", folder, 4, env=env)
+    gathered, _ = gpkg_run(tmp_path / "gathered", "out", folder, 4, "-dim", "XY")
+    assert stats["writer"]["rank_0_writes_every_plan"] == \
+        "the destination's folder is not seen by rank 2 (not a file system every rank shares)", stats["writer"]
+    same_gpkg(got, gathered)
+    assert sorted(os.listdir(tmp_path / "blind")) == ["out.gpkg", "out.json"], "the marker was left behind"
+
+
+@pytest.mark.parametrize("how", ["throw@slice", "kill@slice"])
+def test_a_rank_failing_in_its_gpkg_slice_leaves_no_destination(tmp_path, city, how):
+    """Rank 2 fails once it has written its slice. Thrown: every rank learns it, the destination and every slice
+    are removed, the run fails naming rank 2; nothing is left. Killed: mpirun ends the run; at most rank 0's hidden
+    staging folder is left, never out.gpkg, a slice or the shared-folder marker beside it."""
+    folder, _ = city
+    env = gdal_env()
+    env["GROUNDPLAN_MPI_TEST_FAIL"] = f"2:{how}"
+    p = gpkg_run(tmp_path, "out", folder, 4, env=env, check=False)
+    assert p.returncode != 0
+    assert not (tmp_path / "out.gpkg").exists()
+    left = sorted(os.listdir(tmp_path))
+    if how.startswith("throw"):
+        assert "could not write" in p.stderr and "rank 2: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr, p.stderr
+        assert left == [], left
+    else:
+        assert "rank 2" in p.stderr and "signal 9" in p.stderr, p.stderr
+        assert all(n.startswith(".groundplan-partial-") for n in left), left

@@ -204,8 +204,10 @@ def test_four_ranks_write_into_postgis(server, city, niedersachsen_and_a_bad_til
 @pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
 @pytest.mark.parametrize("how", ["kill", "throw"])
 def test_a_rank_that_dies_before_the_commit_leaves_no_row(server, city, how):
-    """Rank 2 has written its rows (not committed) and dies: the run fails with a message and the tables rank 0
-    made hold no row of it (every rank's transaction is rolled back when the job ends)."""
+    """Rank 2 has written its rows (not committed) and fails. Thrown: every rank learns it and rolls back, and rank 0
+    drops the tables it made in this run (an orderly failure naming rank 2). Killed: mpirun ends every rank, each
+    transaction is rolled back when its connection closes, and the tables rank 0 made stay, without a row (no rank
+    is left to drop them)."""
     folder, _ = city
     env = gdal_env()
     env["GROUNDPLAN_MPI_TEST_FAIL"] = f"2:{how}@commit"
@@ -214,10 +216,37 @@ def test_a_rank_that_dies_before_the_commit_leaves_no_row(server, city, how):
                         "-f", "PostgreSQL", conn, str(folder), "ground_plans", "plan_members", "problems"],
                        capture_output=True, text=True, env=env, timeout=300)
     assert p.returncode != 0
+    tables = ("ground_plans", "plan_members", "problems")
+    present = server.psql(name, "SELECT string_agg(tablename, ',' ORDER BY tablename) FROM pg_tables WHERE "
+                                "schemaname = 'public' AND tablename IN ('ground_plans', 'plan_members', 'problems')")
     if how == "throw":
-        assert "rank 2 of 4: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr and "aborting every rank" in p.stderr, p.stderr
+        assert "could not write" in p.stderr and "rank 2: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr, p.stderr
+        assert "every rank rolled back" in p.stderr and "the tables this run made are dropped" in p.stderr, p.stderr
+        assert present == "", present
     else:
         assert "rank 2" in p.stderr and "signal 9" in p.stderr, p.stderr
-    # the tables exist (rank 0 made them before anyone wrote) and hold nothing
-    for table in ("ground_plans", "plan_members", "problems"):
-        assert server.psql(name, f"SELECT count(*) FROM {table}") == "0", table
+        # the tables exist (rank 0 made them before anyone wrote) and hold nothing
+        assert present == ",".join(sorted(tables))
+        for table in tables:
+            assert server.psql(name, f"SELECT count(*) FROM {table}") == "0", table
+
+
+@pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
+def test_a_failed_run_drops_only_the_tables_it_made(server, city):
+    """A problems table is there before the run (someone else's, with a row; GDAL's ogr2ogr appends to it, adding
+    its columns). Rank 2 fails before the commit: ground_plans and plan_members, which rank 0 made, are dropped; the
+    problems table stays, with its row and nothing of the run."""
+    folder, _ = city
+    name, conn = server.new_database()
+    server.psql(name, "CREATE TABLE problems (note text); INSERT INTO problems VALUES ('kept')")
+    env = gdal_env()
+    env["GROUNDPLAN_MPI_TEST_FAIL"] = "2:throw@commit"
+    p = subprocess.run([*mpirun(4), "-x", "GROUNDPLAN_MPI_TEST_FAIL", BIN, "-q", "--tiles", "on", "--id-field", "bid",
+                        "-f", "PostgreSQL", conn, str(folder), "ground_plans", "plan_members", "problems"],
+                       capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode != 0
+    assert "the tables this run made are dropped: ground_plans, plan_members" in p.stderr, p.stderr
+    present = server.psql(name, "SELECT string_agg(tablename, ',' ORDER BY tablename) FROM pg_tables WHERE "
+                                "schemaname = 'public' AND tablename IN ('ground_plans', 'plan_members', 'problems')")
+    assert present == "problems"
+    assert server.psql(name, "SELECT note FROM problems") == "kept"
