@@ -34,8 +34,8 @@ struct PipelineOptions {
   LodParams detail;                 // level of detail for simulation (issue 9); default: the exact union
   int threads = 0;                  // threads for every stage: --threads, NUM_THREADS=, GDAL_NUM_THREADS; 0 = all cores
   /// CityGML files are cut into chunks of about this many bytes, read side by side (issue 14): 0 = automatic
-  /// (about four chunks a thread, 2-8 MiB; with one thread only a file over 64 MiB, so that each chunk is parsed in
-  /// memory, citygml.h dom_max_bytes), < 0 = never. The result is the same either way.
+  /// (about four chunks a thread, 2-8 MiB; on one thread a file over 64 MiB in 32 MiB chunks, so that each is parsed
+  /// in memory, citygml.h dom_max_bytes), < 0 = never. The result is the same either way.
   std::int64_t read_chunk_bytes = 0;
   /// OGR sources are cut into ranges of about this many features, read side by side, one dataset handle each
   /// (issue 22, gis/ogr_ranges.h): 0 = automatic (about four ranges a thread, at least 20000 features; never with
