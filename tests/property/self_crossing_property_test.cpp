@@ -118,21 +118,3 @@ TEST(SelfCrossingCity, DISABLED_MatchesGeosMakeValidUnionWithoutNearTouch) {
 
 }  // namespace
 }  // namespace groundplan
-namespace groundplan { namespace {
-TEST(SelfCrossingRings, DISABLED_DbgSeed) {
-  const std::uint64_t seed = std::stoull(std::getenv("R20D_SEED"));
-  std::mt19937_64 rng(seed);
-  const auto fps = testing::self_crossing_case(rng);
-  const auto c = testing::run_and_compare(fps, 1);
-  std::cout << c.message << "\n";
-  for (const GroundPlan& g : c.plans) {
-    std::cout << "PLAN";
-    for (auto m : g.members) std::cout << " " << m;
-    std::cout << "\n";
-  }
-  const testing::NearTouch nt = testing::near_touch(c.plans, 8, &fps);
-  std::cout << nt.first << "\n";
-  std::cout << "geos:\n";
-  for (const GroundPlan& g : gis::geos_union(fps)) std::cout << "  " << gis::to_wkt(g.polygon) << "\n";
-}
-}}
