@@ -316,12 +316,6 @@ TEST(SnapRound, NearTouchAloneIsNotSnappedWhereSnappingWouldJoinOrSplitPlans) {
   }
 }
 
-}  // namespace
-}  // namespace groundplan
-
-namespace groundplan {
-namespace {
-
 // A polygon whose ring is given as numerators of sevenths (fuzz_polygons.h's inexact mode, byte 0 = 3).
 Polygon sevenths(const std::vector<std::pair<int, int>>& outer, const std::vector<std::pair<int, int>>& hole = {}) {
   Polygon p;
