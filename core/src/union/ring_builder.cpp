@@ -229,6 +229,15 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
       parts_polys.push_back(rings_[i].polys);
     }
   }
+  // Snap rounding turns no face over (docs/union_engine.md); checked exactly all the same on the snapped rings,
+  // as the last resort: a turned ring would be a bug, reported.
+  if (std::find(parts_snapped.begin(), parts_snapped.end(), 1) != parts_snapped.end()) {
+    const std::vector<char> turned = nesting_flips(parts, parts_snapped);
+    if (std::find(turned.begin(), turned.end(), 1) != turned.end())
+      out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
+                                     "a snap-rounded ring lies inside other rings as if turned over "
+                                     "(a groundplan bug; please report)"});
+  }
   std::vector<R> outers, holes;
   for (std::size_t i = 0; i < parts.size(); ++i) {
     auto& p = parts[i];
