@@ -16,6 +16,22 @@
 // 27 near-touch, 12 other counts; constant on: 990, 1 near-touch, 12 other counts. Branch robust20c
 // (kSnapComputedNearTouch: a valid group near-touching at a computed point is snapped too, unless that
 // changes its ring counts): 986 strict-equal, 12 other counts, 8 near-touch (7 at a computed point).
+// Branch robust20d (nesting_flips: a ring turned over by rounding is snap-rounded): the same 986; the 14 open
+// seeds (printed one a line by the DISABLED_ test), read one by one against GEOS's WKT:
+//  - 20000025: a hole ring that crosses itself as a pentagram and sticks out of its shell: by parity its inner
+//    pentagon stays covered, GEOS MakeValid leaves it out (area 4.8% off); the even-odd sampling agrees with us.
+//  - 20000279, 20000440, 20000679, 20000704: GEOS keeps a feature narrower than the snap pitch (a hole or a sliver
+//    plan whose vertices are an ulp apart, a gap of an ulp between pieces) that snap rounding collapses, as
+//    designed (docs/union_engine.md, "What collapses"); valid, same area.
+//  - 20000837: f0's corner (2/7, 4/7 as doubles) lies exactly on f1's edge (checked with rationals): we give two
+//    plans sharing that vertex, GEOS moves it an ulp and gives one plan with a hole.
+//  - near-touch, 8: 20000261 between input vertices and edges only (GEOS's output has it too); 7 at a computed
+//    point, kept as they are because snapping their group would change its ring counts (the guard of
+//    kSnapComputedNearTouch). Snapping would give GEOS's counts in 20000668, 20000840, 20000992 and not in
+//    20000021, 20000223, 20000634, 20000793 (in 20000021 a dart-shaped sliver plan narrower than the pitch, which
+//    GEOS keeps, collapses); a rule telling the two apart without GEOS was not found.
+// So no engine defect is left among them that this test can show: they are sub-pitch decisions where the
+// strict criterion takes GEOS's rounding as the truth. The tests stay DISABLED_ (never loosened).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,6 +49,7 @@ struct Tally {
   int cases = 0, strict_ok = 0, counts_differ = 0, overlapping = 0, near_touch = 0, near_touch_computed = 0;
   std::vector<std::string> hard;  // failures of what is asserted now
   std::string first_open;         // first failure of the strict criterion
+  std::vector<std::string> open;  // every failure of the strict criterion, one line each
   void print(const char* what) const {
     std::cout << "[ " << what << " ] " << cases << " cases: " << strict_ok
               << " equal to GEOS MakeValid + UnaryUnion by DESIGN.md's criterion; open: " << overlapping
@@ -62,6 +79,9 @@ void check(const std::vector<Footprint>& fps, std::uint64_t seed, int samples, T
   t.overlapping += c.cmp.overlapping_ours > 0;
   t.near_touch += nt.pairs > 0;
   t.near_touch_computed += nt.computed > 0;
+  if (!c.ok || nt.pairs)
+    t.open.push_back("seed " + std::to_string(seed) + ": " + (nt.pairs ? "near-touch " + nt.first + "; " : "") +
+                     c.cmp.summary());
   if ((!c.ok || nt.pairs) && t.first_open.empty()) {
     std::ostringstream m;
     m << "seed " << seed << ": " << (nt.pairs ? nt.first + "; " : "") << c.message.substr(0, 3000);
@@ -103,6 +123,7 @@ TEST(SelfCrossingRings, DISABLED_MatchesGeosMakeValidUnionWithoutNearTouch) {
   const Tally t = run_cases();
   t.print("self-crossing rings");
   EXPECT_EQ(t.strict_ok, t.cases) << t.first_open;
+  for (const std::string& o : t.open) std::cout << "  open: " << o << "\n";
 }
 
 TEST(SelfCrossingCity, DISABLED_MatchesGeosMakeValidUnionWithoutNearTouch) {

@@ -11,6 +11,8 @@
 #include <utility>
 
 #include "robust/predicates.h"
+#include "union/block_types.h"
+#include "union/box_grid.h"
 
 namespace groundplan::detail {
 
@@ -202,6 +204,53 @@ bool touch_cycle(const std::vector<std::vector<Point2>*>& rings) {
   for (std::size_t x = 0; x < parent.size(); ++x)
     if (parent[x] == x && hole[x] && cycle[x]) return true;
   return false;
+}
+
+std::vector<char> nesting_flips(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& subject) {
+  const std::size_t n = rings.size();
+  std::vector<char> flip(n, 0);
+  if (std::find(subject.begin(), subject.end(), 1) == subject.end()) return flip;
+  std::vector<Box> box(n);
+  Box all;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const Point2& p : rings[i]) box[i].add(p);
+    all.add({box[i].minx, box[i].miny});
+    all.add({box[i].maxx, box[i].maxy});
+  }
+  auto within = [](const Box& in, const Box& out) {
+    return out.minx <= in.minx && in.maxx <= out.maxx && out.miny <= in.miny && in.maxy <= out.maxy;
+  };
+  // +1 if ring s lies strictly inside ring q, -1 outside, 0 undecided (every vertex and edge midpoint on q)
+  auto inside = [&](std::size_t s, std::size_t q) {
+    const auto& S = rings[s];
+    for (const Point2& p : S)
+      if (const int l = point_in_ring(p, rings[q])) return l;
+    for (std::size_t i = 0; i < S.size(); ++i) {
+      const Point2& a = S[i];
+      const Point2& b = S[(i + 1) % S.size()];
+      if (const int l = point_in_ring({0.5 * a.x + 0.5 * b.x, 0.5 * a.y + 0.5 * b.y}, rings[q])) return l;
+    }
+    return 0;
+  };
+  auto check = [&](std::size_t s, auto&& candidates) {
+    const int o = rings[s].size() >= 3 ? ring_orientation(rings[s]) : 0;
+    if (o == 0) return;
+    std::size_t count = 0;
+    candidates([&](std::size_t q) {
+      if (q != s && rings[q].size() >= 3 && within(box[s], box[q]) && inside(s, q) > 0) ++count;
+    });
+    flip[s] = (o > 0) == (count % 2 == 1);
+  };
+  if (n <= 64) {
+    for (std::size_t s = 0; s < n; ++s)
+      if (subject[s]) check(s, [&](auto&& f) { for (std::size_t q = 0; q < n; ++q) f(q); });
+    return flip;
+  }
+  BoxGrid grid;
+  grid.build(box, all, n);
+  for (std::size_t s = 0; s < n; ++s)
+    if (subject[s]) check(s, [&](auto&& f) { grid.query(box[s], [&](std::uint32_t q) { f(q); }); });
+  return flip;
 }
 
 }  // namespace groundplan::detail

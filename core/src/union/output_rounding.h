@@ -24,4 +24,13 @@ bool find_conflict(const std::vector<std::vector<Point2>*>& rings, Conflict& c);
 /// are "union on the left" (holes clockwise); a ring touching itself is find_conflict's concern.
 bool touch_cycle(const std::vector<std::vector<Point2>*>& rings);
 
+/// Rings whose orientation contradicts their nesting, for the rings flagged in `subject` (others get 0).
+/// Union on the left: an outer ring (counter-clockwise) lies strictly inside an even number of the other
+/// rings (none, or an outer ring and one of its holes), a hole (clockwise) inside an odd number. A ring
+/// narrower than an ulp somewhere can turn over when its computed vertices are rounded: a sliver hole
+/// then comes out as an outer ring lying inside another plan, which crosses no edge and touches no ring
+/// (fuzz regression e393fd6c), or a sliver island as a hole inside another hole. Exact on the doubles;
+/// a ring all of whose vertices lie on another ring is not counted inside it.
+std::vector<char> nesting_flips(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& subject);
+
 }  // namespace groundplan::detail

@@ -316,5 +316,63 @@ TEST(SnapRound, NearTouchAloneIsNotSnappedWhereSnappingWouldJoinOrSplitPlans) {
   }
 }
 
+// A polygon whose ring is given as numerators of sevenths (fuzz_polygons.h's inexact mode, byte 0 = 3).
+Polygon sevenths(const std::vector<std::pair<int, int>>& outer, const std::vector<std::pair<int, int>>& hole = {}) {
+  Polygon p;
+  for (const auto& [x, y] : outer) p.outer.push_back({x / 7.0, y / 7.0});
+  if (!hole.empty()) {
+    p.holes.emplace_back();
+    for (const auto& [x, y] : hole) p.holes.back().push_back({x / 7.0, y / 7.0});
+  }
+  return p;
+}
+
+// fuzz regression plans-overlap-self-intersecting-e393fd6c: among self-crossing rings in sevenths, a walk of
+// the exact union is a sliver hole A-B-C narrower than an ulp, B and C distinct crossings along one edge one ulp
+// apart. Rounded, it turns over: an outer ring (13.0876 14.0945), (10.482625482625481 13.8340),
+// (10.482625482625483 13.8340) lying inside the big plan, crossing no edge and touching no ring, and more than
+// 4 pitches from every other walk, so it was a proximity group of its own that only near-touched; snapping
+// it collapses it, which changes its ring counts, so it was kept: two plans overlapped, 5 plans vs GEOS's 4.
+// nesting_flips finds the turned ring (an outer ring inside an odd number of rings): its group is snap-rounded.
+TEST(SnapRound, SliverHoleTurnedOverByRoundingIsSnapped) {
+  std::vector<Footprint> fps(3);
+  fps[0].source_id = "f0";
+  fps[0].polygons.push_back(sevenths({{240, 181}, {32, 181}, {5, 5}, {15, 5}, {15, 46}, {255, 255}, {255, 255}, {1, 0},
+                                      {0, 11}, {255, 255}, {255, 255}, {255, 255}, {255, 255}},
+                                     {{255, 255}, {255, 255}, {255, 255}, {255, 255}, {255, 255}}));
+  fps[1].source_id = "f1";
+  fps[1].polygons.push_back(sevenths({{255, 255}, {255, 255}, {126, 49}, {49, 55}, {95, 95}, {99, 108}},
+                                     {{97, 115}, {115, 101}, {55, 95}, {95, 99}, {108, 19}, {7, 176}}));
+  fps[2].source_id = "f2";
+  fps[2].polygons.push_back(sevenths({{0, 0}, {0, 0}, {0, 0}, {0, 0}}));
+  const auto c = testing::run_and_compare(fps, 1);
+  EXPECT_TRUE(c.ok) << c.message;  // GEOS MakeValid + UnaryUnion: 4 polygons, 4 holes, same area
+  EXPECT_EQ(c.cmp.overlapping_ours, 0u);
+  EXPECT_EQ(c.plans.size(), 4u);
+  for (const GroundPlan& g : c.plans)
+    for (const Point2& p : g.polygon.outer) EXPECT_FALSE(p.x > 10.48 && p.x < 10.49 && p.y > 13.83 && p.y < 13.84);
+  const testing::NearTouch nt = testing::near_touch(c.plans, 8, &fps);
+  EXPECT_EQ(nt.computed, 0u) << nt.first_computed;
+}
+
+// nesting_flips on its own: an outer ring must lie inside an even number of rings, a hole inside an odd one.
+TEST(SnapRound, NestingFlipsFindsRingsTurnedOver) {
+  const std::vector<Point2> shell{{0, 0}, {10, 0}, {10, 10}, {0, 10}};     // counter-clockwise
+  const std::vector<Point2> hole{{2, 2}, {2, 8}, {8, 8}, {8, 2}};          // clockwise, inside the shell
+  const std::vector<Point2> island{{3, 3}, {5, 3}, {5, 5}, {3, 5}};        // counter-clockwise, in the hole
+  const std::vector<Point2> island_cw{{3, 3}, {3, 5}, {5, 5}, {5, 3}};     // the island turned over
+  const std::vector<Point2> sliver_ccw{{1, 1}, {1.5, 1}, {1.5, 1.5}};      // an outer ring inside the shell
+  const std::vector<Point2> touching_hole{{0, 5}, {1, 6}, {1, 4}};         // clockwise, touching the shell at (0,5)
+  const std::vector<Point2> far_ccw{{20, 20}, {21, 20}, {21, 21}};         // a separate plan
+  using V = std::vector<std::vector<Point2>>;
+  EXPECT_EQ(detail::nesting_flips(V{shell, hole, island}, {1, 1, 1}), (std::vector<char>{0, 0, 0}));
+  EXPECT_EQ(detail::nesting_flips(V{shell, hole, island_cw}, {1, 1, 1}), (std::vector<char>{0, 0, 1}));
+  EXPECT_EQ(detail::nesting_flips(V{shell, sliver_ccw}, {1, 1}), (std::vector<char>{0, 1}));
+  EXPECT_EQ(detail::nesting_flips(V{shell, sliver_ccw}, {1, 0}), (std::vector<char>{0, 0}));  // subjects only
+  EXPECT_EQ(detail::nesting_flips(V{shell, touching_hole, far_ccw}, {1, 1, 1}), (std::vector<char>{0, 0, 0}));
+  // a hole alone (no shell around it) is turned over too
+  EXPECT_EQ(detail::nesting_flips(V{hole}, {1}), (std::vector<char>{1}));
+}
+
 }  // namespace
 }  // namespace groundplan
