@@ -1142,7 +1142,7 @@ void read_citygml_buffer(std::string_view xml, const std::string& name, const Ci
 void read_citygml_chunk(const std::string& path, const CityGmlChunkPlan& plan, std::size_t k,
                         const CityGmlOptions& options, const MeshCallback& on_mesh, std::vector<Problem>& problems,
                         SourceInfo& info, CityGmlChunkWatch& watch) {
-  const auto [begin, end] = plan.ranges.at(k);
+  const std::uint64_t begin = plan.ranges.at(k).first, end = plan.ranges.at(k).second;  // lambdas capture these
   const bool last = k + 1 == plan.ranges.size();
   const VsiHandle file = open_file(path);
   VSILFILE* fp = file.get();
