@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "gpkg_rank_slices.h"
 
+#include "rank_writes.h"
 #include "sqlite_db.h"
 
 #include <cpl_error.h>
@@ -17,19 +18,6 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// Every rank's `text`, in rank order.
-std::vector<std::string> gather_text(gis::TileExchange& ex, const std::string& text) {
-  std::vector<std::uint64_t> sizes;
-  const std::vector<char> all = ex.allgather(std::vector<char>(text.begin(), text.end()), &sizes);
-  std::vector<std::string> out;
-  std::size_t at = 0;
-  for (std::uint64_t n : sizes) {
-    out.emplace_back(all.data() + at, static_cast<std::size_t>(n));
-    at += static_cast<std::size_t>(n);
-  }
-  return out;
 }
 
 void add_run(std::vector<FidRun>& runs, std::uint64_t first, std::uint64_t count) {

@@ -562,6 +562,14 @@ class NoPlans final : public groundplan::gis::TiledResult {
   std::uint64_t members_before(std::size_t) const override { return 0; }
 };
 
+/// The tiled run over ranks, every rank keeping its own final plans to write them itself.
+std::shared_ptr<const groundplan::gis::TiledResult> tiled_kept_by_each_rank(const PipelineOptions& options,
+                                                                        const groundplan::Progress& progress,
+                                                                        Ranks& ranks) {
+  return groundplan::gis::run_pipeline_tiled(options, ranks, ranks.rank() == 0 ? progress : groundplan::Progress{},
+                                             groundplan::gis::FinalPlans::kept_by_each_rank);
+}
+
 /// The tiled run over ranks into PostgreSQL (issue 15 stage 5, rank_writes.h): every rank writes its own final
 /// plans into the tables rank 0 makes, each in a transaction committed once all have written.
 int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& ogr, const std::string& stats_path,
@@ -569,8 +577,7 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   const double cpu0 = groundplan::gis::process_cpu_seconds();
   const auto t0 = clock::now();
   const bool root = ranks.rank() == 0;
-  std::shared_ptr<const groundplan::gis::TiledResult> result = groundplan::gis::run_pipeline_tiled(
-      options, ranks, root ? progress : groundplan::Progress{}, groundplan::gis::FinalPlans::kept_by_each_rank);
+  std::shared_ptr<const groundplan::gis::TiledResult> result = tiled_kept_by_each_rank(options, progress, ranks);
   const groundplan::gis::TiledResult& r = *result;
   const std::size_t plans = r.tiles.final_plans + r.tiles.reduced_plans;  // rank 0: over all ranks
   groundplan::cli::TableSetup setup;
@@ -665,8 +672,7 @@ int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& o
   const double cpu0 = groundplan::gis::process_cpu_seconds();
   const auto t0 = clock::now();
   const bool root = ranks.rank() == 0;
-  std::shared_ptr<const groundplan::gis::TiledResult> result = groundplan::gis::run_pipeline_tiled(
-      options, ranks, root ? progress : groundplan::Progress{}, groundplan::gis::FinalPlans::kept_by_each_rank);
+  std::shared_ptr<const groundplan::gis::TiledResult> result = tiled_kept_by_each_rank(options, progress, ranks);
   const groundplan::gis::TiledResult& r = *result;
   const std::size_t plans = r.tiles.final_plans + r.tiles.reduced_plans;  // rank 0: over all ranks
   std::unique_ptr<groundplan::cli::StagedOutput> staged;

@@ -19,19 +19,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Every rank's `text` (empty: all went well), in rank order.
-std::vector<std::string> gather_text(gis::TileExchange& ex, const std::string& text) {
-  std::vector<std::uint64_t> sizes;
-  const std::vector<char> all = ex.allgather(std::vector<char>(text.begin(), text.end()), &sizes);
-  std::vector<std::string> out;
-  std::size_t at = 0;
-  for (std::uint64_t n : sizes) {
-    out.emplace_back(all.data() + at, static_cast<std::size_t>(n));
-    at += static_cast<std::size_t>(n);
-  }
-  return out;
-}
-
 /// "rank R: why; rank S: why" over the ranks that failed; empty when none did.
 std::string failures(const std::vector<std::string>& texts) {
   std::string out;
@@ -273,6 +260,19 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   }
   w.ok = true;
   return w;
+}
+
+/// Every rank's `text` (empty: all went well), in rank order.
+std::vector<std::string> gather_text(gis::TileExchange& ex, const std::string& text) {
+  std::vector<std::uint64_t> sizes;
+  const std::vector<char> all = ex.allgather(std::vector<char>(text.begin(), text.end()), &sizes);
+  std::vector<std::string> out;
+  std::size_t at = 0;
+  for (std::uint64_t n : sizes) {
+    out.emplace_back(all.data() + at, static_cast<std::size_t>(n));
+    at += static_cast<std::size_t>(n);
+  }
+  return out;
 }
 
 }  // namespace groundplan::cli

@@ -28,6 +28,9 @@ bool written_by_every_rank(const std::string& format, const std::string& dst);
 /// dataset: ogc_fid = gp_id) are added; -preserve_fid not where -unsetFid or -explodecollections asks otherwise.
 std::vector<std::string> append_options(const std::vector<std::string>& options);
 
+/// Every rank's `text`, in rank order (an allgather; also used by gpkg_rank_slices.cpp).
+std::vector<std::string> gather_text(gis::TileExchange& ex, const std::string& text);
+
 /// What rank 0 needs to create the tables.
 struct TableSetup {
   std::string dst;                   // the PG: datasource
