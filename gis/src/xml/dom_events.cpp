@@ -74,7 +74,7 @@ std::size_t utf8_length(std::string_view d, std::size_t at) {
 /// A prefix of up to 8 bytes packed into an integer (longer ones: 0, compared as strings).
 std::uint64_t pack(std::string_view prefix) {
   std::uint64_t k = 0;
-  if (prefix.size() <= 8) std::memcpy(&k, prefix.data(), prefix.size());
+  if (!prefix.empty() && prefix.size() <= 8) std::memcpy(&k, prefix.data(), prefix.size());  // data() may be null
   return k;
 }
 
