@@ -93,6 +93,51 @@ const char* colon_of(const char* name) {
   return nullptr;
 }
 
+/// The inside of an XML declaration (between "<?xml" and "?>"): "" when it is XMLDecl's grammar with
+/// version 1.x, an encoding of UTF-8 or US-ASCII if any, standalone yes or no if any; else why not.
+std::string check_declaration(std::string_view decl) {
+  std::size_t q = 0;
+  const auto spaces = [&] {
+    const std::size_t at = q;
+    while (q < decl.size() && is_space(decl[q])) ++q;
+    return q > at;
+  };
+  // at least one space, then name Eq quoted-value: the value; false when malformed
+  const auto pseudo = [&](std::string_view name, std::string& value) {
+    if (!spaces() || decl.compare(q, name.size(), name) != 0) return false;
+    q += name.size();
+    spaces();
+    if (q >= decl.size() || decl[q] != '=') return false;
+    ++q;
+    spaces();
+    if (q >= decl.size() || (decl[q] != '"' && decl[q] != '\'')) return false;
+    const std::size_t close = decl.find(decl[q], q + 1);
+    if (close == std::string_view::npos) return false;
+    value = std::string(decl.substr(q + 1, close - q - 1));
+    q = close + 1;
+    return true;
+  };
+  std::string version, encoding, standalone;
+  if (!pseudo("version", version) || version.size() < 3 || version.compare(0, 2, "1.") != 0 ||
+      version.find_first_not_of("0123456789", 2) != std::string::npos)
+    return "an XML declaration without a version 1.x";
+  std::size_t mark = q;
+  if (pseudo("encoding", encoding)) {
+    for (char& c : encoding) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+    if (encoding != "utf-8" && encoding != "us-ascii") return "the encoding \"" + encoding + "\"";
+    mark = q;
+  } else {
+    q = mark;
+  }
+  if (pseudo("standalone", standalone)) {
+    if (standalone != "yes" && standalone != "no") return "an XML declaration with standalone=\"" + standalone + "\"";
+  } else {
+    q = mark;
+  }
+  spaces();
+  return q == decl.size() ? "" : "an XML declaration expat would not read";
+}
+
 }  // namespace
 
 std::string check_xml_text(std::string_view d) {
@@ -362,17 +407,7 @@ std::string DomEvents::load(const char* bytes, std::size_t n) {
   if (starts_with(d, p, "<?xml") && d.size() > p + 5 && (is_space(d[p + 5]) || d[p + 5] == '?')) {
     const std::size_t end = d.find("?>", p);
     if (end == std::string_view::npos) return "an unclosed XML declaration";
-    const std::string_view decl = d.substr(p, end - p);
-    if (const std::size_t e = decl.find("encoding"); e != std::string_view::npos) {
-      std::size_t q = e + 8;
-      while (q < decl.size() && (is_space(decl[q]) || decl[q] == '=')) ++q;
-      if (q >= decl.size() || (decl[q] != '"' && decl[q] != '\'')) return "an unreadable encoding declaration";
-      const std::size_t close = decl.find(decl[q], q + 1);
-      if (close == std::string_view::npos) return "an unreadable encoding declaration";
-      std::string enc(decl.substr(q + 1, close - q - 1));
-      for (char& c : enc) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-      if (enc != "utf-8" && enc != "us-ascii") return "the encoding \"" + enc + "\"";
-    }
+    if (std::string why = check_declaration(d.substr(p + 5, end - p - 5)); !why.empty()) return why;
     p = end + 2;
   }
   p = m.skip_misc(p);
