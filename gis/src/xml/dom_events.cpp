@@ -269,12 +269,12 @@ struct DomEvents::Impl {
     for (pugi::xml_attribute a = n.first_attribute(); a; a = a.next_attribute()) {
       if (++count > kMaxAttributes) return "an element with more than " + std::to_string(kMaxAttributes) + " attributes";
       const char* an = a.name();
+      if (std::strchr(a.value(), '<')) return "a '<' in the value of \"" + std::string(an) + "\"";  // or &lt;: expat's
       if (is_declaration(an)) continue;
       const char* al;
       bool ap;
       const Binding* ab = resolve(an, true, al, ap);
       if (ap && (al == an + 1 || !*al || colon_of(al))) return "the attribute name \"" + std::string(an) + "\"";
-      if (std::strchr(a.value(), '<')) return "a '<' in the value of \"" + std::string(an) + "\"";  // or &lt;: expat's
       if (ap && !ab) return "the unbound prefix of \"" + std::string(an) + "\"";
       // duplicates, by (namespace, local name) as expat compares them
       const std::string_view uri = ap ? ab->uri : std::string_view();

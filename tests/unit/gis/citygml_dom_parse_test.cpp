@@ -248,6 +248,8 @@ TEST(CityGmlInMemory, DocumentsPugixmlWouldReadOtherwiseGoToExpat) {
             "</core:cityObjectMember>" + body)},
       {"unbound prefix", city(body + "<nope:Thing/>")},
       {"empty prefix binding", city("<x xmlns:p=\"\"/>" + body)},
+      {"'<' in a namespace declaration (fuzz_citygml)", city("<x xmlns:p=\"a<b\"/>" + body)},
+      {"'<' in an attribute", city("<x a=\"a<b\"/>" + body)},
       {"truncated", ok.substr(0, ok.size() / 2 + 40)},
       {"mismatched end tag", city(body + "<a></b>")},
       {"empty", ""},
