@@ -234,6 +234,7 @@ struct DomEvents::Impl {
       if (an[5] && (prefix.empty() || uri.empty() || prefix == "xml" || prefix == "xmlns"))
         return "the namespace declaration " + std::string(an);
       if (uri == kXmlNs) return "a declaration of the XML namespace";
+      if (uri.find(' ') != std::string_view::npos) return "a namespace URI with a space";  // expat's separator
       Binding b{prefix, uri, std::string()};
       if (!uri.empty()) b.expanded.append(uri).push_back(' ');
       bindings.push_back(std::move(b));

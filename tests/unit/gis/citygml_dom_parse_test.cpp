@@ -250,6 +250,7 @@ TEST(CityGmlInMemory, DocumentsPugixmlWouldReadOtherwiseGoToExpat) {
       {"empty prefix binding", city("<x xmlns:p=\"\"/>" + body)},
       {"'<' in a namespace declaration (fuzz_citygml)", city("<x xmlns:p=\"a<b\"/>" + body)},
       {"'<' in an attribute", city("<x a=\"a<b\"/>" + body)},
+      {"a space in a namespace URI (fuzz_citygml)", city("<x xmlns:p=\"a b\"/>" + body)},
       {"truncated", ok.substr(0, ok.size() / 2 + 40)},
       {"mismatched end tag", city(body + "<a></b>")},
       {"empty", ""},
