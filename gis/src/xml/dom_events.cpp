@@ -231,7 +231,7 @@ struct DomEvents::Impl {
       if (!is_declaration(an)) continue;
       const std::string_view prefix = an[5] ? std::string_view(an + 6) : std::string_view();
       const std::string_view uri = a.value();
-      if (an[5] && (prefix.empty() || uri.empty() || prefix == "xml" || prefix == "xmlns"))
+      if (an[5] && (prefix.empty() || uri.empty() || prefix == "xml" || prefix == "xmlns" || colon_of(prefix.data())))
         return "the namespace declaration " + std::string(an);
       if (uri == kXmlNs) return "a declaration of the XML namespace";
       if (uri.find(' ') != std::string_view::npos) return "a namespace URI with a space";  // expat's separator

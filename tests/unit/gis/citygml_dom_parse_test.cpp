@@ -251,6 +251,7 @@ TEST(CityGmlInMemory, DocumentsPugixmlWouldReadOtherwiseGoToExpat) {
       {"'<' in a namespace declaration (fuzz_citygml)", city("<x xmlns:p=\"a<b\"/>" + body)},
       {"'<' in an attribute", city("<x a=\"a<b\"/>" + body)},
       {"a space in a namespace URI (fuzz_citygml)", city("<x xmlns:p=\"a b\"/>" + body)},
+      {"a prefix with a colon (fuzz_citygml)", city("<x xmlns:p:q=\"a\"/>" + body)},
       {"truncated", ok.substr(0, ok.size() / 2 + 40)},
       {"mismatched end tag", city(body + "<a></b>")},
       {"empty", ""},
