@@ -86,6 +86,40 @@ struct Binding {
   std::uint64_t key = pack(prefix);
 };
 
+/// An element or attribute name of ASCII name characters only, not starting with a digit, '-' or '.':
+/// the names expat and pugixml both read alike (pugixml takes any byte >= 0x80 as a name character, expat
+/// only those Unicode allows).
+bool plain_name(const char* name) {
+  const auto c0 = static_cast<unsigned char>(*name);
+  if (!c0 || (c0 >= '0' && c0 <= '9') || c0 == '-' || c0 == '.') return false;
+  for (; *name; ++name) {
+    const auto c = static_cast<unsigned char>(*name);
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+          c == '.' || c == ':'))
+      return false;
+  }
+  return true;
+}
+
+/// "p:local" -> where the colon is, or nullptr.
+const char* colon_of(const char* name);
+
+/// Why expat would refuse a comment or a processing instruction that pugixml read: "--" inside a comment
+/// or "-" at its end; a PI target named xml in any case, or one that is not a plain name.
+std::string misc_problem(pugi::xml_node n) {
+  const char* v = n.value();
+  if (n.type() == pugi::node_comment) {
+    const std::size_t len = std::strlen(v);
+    if (std::strstr(v, "--") || (len && v[len - 1] == '-')) return "\"--\" in a comment";
+    return "";
+  }
+  const char* t = n.name();
+  if (!plain_name(t) || colon_of(t)) return "a processing instruction named \"" + std::string(t) + "\"";
+  if (std::strlen(t) == 3 && (t[0] | 0x20) == 'x' && (t[1] | 0x20) == 'm' && (t[2] | 0x20) == 'l')
+    return "a processing instruction named \"" + std::string(t) + "\"";
+  return "";
+}
+
 /// "p:local" -> where the colon is, or nullptr.
 const char* colon_of(const char* name) {
   for (; *name; ++name)
@@ -235,6 +269,8 @@ struct DomEvents::Impl {
         return "the namespace declaration " + std::string(an);
       if (uri == kXmlNs) return "a declaration of the XML namespace";
       if (uri.find(' ') != std::string_view::npos) return "a namespace URI with a space";  // expat's separator
+      for (std::size_t k = marks.back(); k < bindings.size(); ++k)
+        if (bindings[k].prefix == prefix) return "the namespace declaration " + std::string(an) + " twice";
       Binding b{prefix, uri, std::string()};
       if (!uri.empty()) b.expanded.append(uri).push_back(' ');
       bindings.push_back(std::move(b));
@@ -262,6 +298,7 @@ struct DomEvents::Impl {
     const char* local;
     bool prefixed;
     const char* qname = n.name();
+    if (!plain_name(qname)) return "the element name \"" + std::string(qname) + "\"";
     const Binding* b = resolve(qname, false, local, prefixed);
     if (prefixed && (local == qname + 1 || !*local || colon_of(local)))
       return "the element name \"" + std::string(qname) + "\"";
@@ -270,6 +307,7 @@ struct DomEvents::Impl {
     for (pugi::xml_attribute a = n.first_attribute(); a; a = a.next_attribute()) {
       if (++count > kMaxAttributes) return "an element with more than " + std::to_string(kMaxAttributes) + " attributes";
       const char* an = a.name();
+      if (!plain_name(an)) return "the attribute name \"" + std::string(an) + "\"";
       if (std::strchr(a.value(), '<')) return "a '<' in the value of \"" + std::string(an) + "\"";  // or &lt;: expat's
       if (is_declaration(an)) continue;
       const char* al;
@@ -320,12 +358,14 @@ struct DomEvents::Impl {
     empty = p > 0 && p < data.size() && data[p - 1] == '/';
     return std::min(p + 1, data.size());
   }
-  /// Just past the last byte of a text or CDATA node.
+  /// Just past the last byte of a text, CDATA, comment or PI node.
   std::size_t text_end(pugi::xml_node n) const {
     const auto at = static_cast<std::size_t>(n.offset_debug());
-    if (n.type() == pugi::node_cdata) {
-      const std::size_t e = data.find("]]>", at);
-      return e == std::string_view::npos ? data.size() : e + 3;
+    const char* close = n.type() == pugi::node_cdata ? "]]>" : n.type() == pugi::node_comment ? "-->"
+                        : n.type() == pugi::node_pi ? "?>" : nullptr;
+    if (close) {
+      const std::size_t e = data.find(close, at);
+      return e == std::string_view::npos ? data.size() : e + std::strlen(close);
     }
     const std::size_t e = data.find('<', at);
     return e == std::string_view::npos ? data.size() : e;
@@ -379,7 +419,7 @@ struct DomEvents::Impl {
           continue;
         }
         if (!on_end(n)) return false;
-      } else if (n.type() == pugi::node_pcdata || n.type() == pugi::node_cdata) {
+      } else if (n.type() != pugi::node_null) {  // text, CDATA, a comment or a PI
         if (!on_text(n)) return false;
       }
       for (;;) {
@@ -417,11 +457,15 @@ std::string DomEvents::load(const char* bytes, std::size_t n) {
   if (std::string why = check_xml_text(d); !why.empty()) return why;
 
   // parse_declaration: pugixml then refuses "<?xml" inside an element (it takes it for a PI otherwise).
-  const unsigned flags = pugi::parse_default | pugi::parse_ws_pcdata_single | pugi::parse_declaration;
+  // parse_comments, parse_pi: kept as nodes, so that the checks below see them as expat does.
+  const unsigned flags = pugi::parse_default | pugi::parse_ws_pcdata_single | pugi::parse_declaration |
+                         pugi::parse_comments | pugi::parse_pi;
   const pugi::xml_parse_result r = m.doc.load_buffer(bytes, n, flags, pugi::encoding_utf8);
   if (!r) return std::string("pugixml: ") + r.description() + " at byte " + std::to_string(r.offset);
   std::size_t roots = 0;
   for (pugi::xml_node c = m.doc.first_child(); c; c = c.next_sibling()) {
+    if (c.type() == pugi::node_comment || c.type() == pugi::node_pi)
+      if (std::string why = misc_problem(c); !why.empty()) return why;
     if (c.type() == pugi::node_declaration && c != m.doc.first_child()) return "an XML declaration past the start";
     if (c.type() != pugi::node_comment && c.type() != pugi::node_pi && c.type() != pugi::node_declaration) ++roots;
   }
@@ -450,6 +494,10 @@ std::string DomEvents::load(const char* bytes, std::size_t n) {
         return why.empty();
       },
       [&](pugi::xml_node t) {  // "]]>" outside CDATA: an error for expat, text for pugixml
+        if (t.type() == pugi::node_comment || t.type() == pugi::node_pi) {
+          why = misc_problem(t);
+          return why.empty();
+        }
         if (t.type() == pugi::node_pcdata)
           for (const char* v = std::strchr(t.value(), ']'); v; v = std::strchr(v + 1, ']'))
             if (v[1] == ']' && v[2] == '>') {
@@ -509,7 +557,7 @@ void DomEvents::walk(Sink& sink) {
         return !sink.stopped();
       },
       [&](pugi::xml_node t) {
-        if (sink.wants_text()) {
+        if ((t.type() == pugi::node_pcdata || t.type() == pugi::node_cdata) && sink.wants_text()) {
           const char* v = t.value();
           sink.text(v, std::strlen(v));
         }
