@@ -265,7 +265,8 @@ struct DomEvents::Impl {
       if (!is_declaration(an)) continue;
       const std::string_view prefix = an[5] ? std::string_view(an + 6) : std::string_view();
       const std::string_view uri = a.value();
-      if (an[5] && (prefix.empty() || uri.empty() || prefix == "xml" || prefix == "xmlns" || colon_of(prefix.data())))
+      if (an[5] && (prefix.empty() || uri.empty() || prefix == "xml" || prefix == "xmlns" || colon_of(prefix.data()) ||
+                    !plain_name(prefix.data())))
         return "the namespace declaration " + std::string(an);
       if (uri == kXmlNs) return "a declaration of the XML namespace";
       if (uri.find(' ') != std::string_view::npos) return "a namespace URI with a space";  // expat's separator
@@ -300,7 +301,7 @@ struct DomEvents::Impl {
     const char* qname = n.name();
     if (!plain_name(qname)) return "the element name \"" + std::string(qname) + "\"";
     const Binding* b = resolve(qname, false, local, prefixed);
-    if (prefixed && (local == qname + 1 || !*local || colon_of(local)))
+    if (prefixed && (local == qname + 1 || !plain_name(local) || colon_of(local)))
       return "the element name \"" + std::string(qname) + "\"";
     if (prefixed && !b) return "the unbound prefix of \"" + std::string(qname) + "\"";
     std::size_t count = 0;
@@ -313,7 +314,7 @@ struct DomEvents::Impl {
       const char* al;
       bool ap;
       const Binding* ab = resolve(an, true, al, ap);
-      if (ap && (al == an + 1 || !*al || colon_of(al))) return "the attribute name \"" + std::string(an) + "\"";
+      if (ap && (al == an + 1 || !plain_name(al) || colon_of(al))) return "the attribute name \"" + std::string(an) + "\"";
       if (ap && !ab) return "the unbound prefix of \"" + std::string(an) + "\"";
       // duplicates, by (namespace, local name) as expat compares them
       const std::string_view uri = ap ? ab->uri : std::string_view();

@@ -257,6 +257,7 @@ TEST(CityGmlInMemory, DocumentsPugixmlWouldReadOtherwiseGoToExpat) {
       {"'--' in a comment", city("<!-- a -- b -->" + body)},
       {"a comment ending in '-'", city(body + "<!-- a --->")},
       {"a PI named XML", city(body + "<?XML x?>")},
+      {"a local name starting with '.' (fuzz_citygml)", city("<x xlink:.ref=\"a\"/>" + body)},
       {"truncated", ok.substr(0, ok.size() / 2 + 40)},
       {"mismatched end tag", city(body + "<a></b>")},
       {"empty", ""},
