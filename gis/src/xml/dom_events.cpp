@@ -446,7 +446,8 @@ std::string DomEvents::load(const char* bytes, std::size_t n) {
   // The prolog: an optional BOM and declaration (UTF-8 only), comments and PIs; no DOCTYPE.
   std::size_t p = 0;
   if (starts_with(d, 0, "\xEF\xBB\xBF")) p = 3;
-  if (starts_with(d, p, "<?xml") && d.size() > p + 5 && (is_space(d[p + 5]) || d[p + 5] == '?')) {
+  const bool declared = starts_with(d, p, "<?xml") && d.size() > p + 5 && (is_space(d[p + 5]) || d[p + 5] == '?');
+  if (declared) {
     const std::size_t end = d.find("?>", p);
     if (end == std::string_view::npos) return "an unclosed XML declaration";
     if (std::string why = check_declaration(d.substr(p + 5, end - p - 5)); !why.empty()) return why;
@@ -467,7 +468,8 @@ std::string DomEvents::load(const char* bytes, std::size_t n) {
   for (pugi::xml_node c = m.doc.first_child(); c; c = c.next_sibling()) {
     if (c.type() == pugi::node_comment || c.type() == pugi::node_pi)
       if (std::string why = misc_problem(c); !why.empty()) return why;
-    if (c.type() == pugi::node_declaration && c != m.doc.first_child()) return "an XML declaration past the start";
+    if (c.type() == pugi::node_declaration && (!declared || c != m.doc.first_child()))
+      return "an XML declaration past the start";
     if (c.type() != pugi::node_comment && c.type() != pugi::node_pi && c.type() != pugi::node_declaration) ++roots;
   }
   if (roots != 1 || !m.doc.document_element()) return "not exactly one root element";

@@ -258,6 +258,7 @@ TEST(CityGmlInMemory, DocumentsPugixmlWouldReadOtherwiseGoToExpat) {
       {"a comment ending in '-'", city(body + "<!-- a --->")},
       {"a PI named XML", city(body + "<?XML x?>")},
       {"a local name starting with '.' (fuzz_citygml)", city("<x xlink:.ref=\"a\"/>" + body)},
+      {"spaces before the declaration (fuzz_citygml)", "   " + ok},
       {"truncated", ok.substr(0, ok.size() / 2 + 40)},
       {"mismatched end tag", city(body + "<a></b>")},
       {"empty", ""},
