@@ -295,6 +295,17 @@ struct DomEvents::Impl {
   }
 
   // ---- checks before any event ----
+  /// Elements whose text the CityGML reader keeps. Holding elements, they would read otherwise: pugixml
+  /// drops the whitespace between child elements that expat hands over as text.
+  static bool text_element(std::string_view local) {
+    return local == "posList" || local == "pos" || local == "coordinates" || local == "name" ||
+           local == "measuredHeight" || local == "lowerCorner" || local == "upperCorner";
+  }
+  static bool holds_elements(pugi::xml_node n) {
+    for (pugi::xml_node c = n.first_child(); c; c = c.next_sibling())
+      if (c.type() == pugi::node_element) return true;
+    return false;
+  }
   std::string check_element(pugi::xml_node n) {
     const char* local;
     bool prefixed;
@@ -304,6 +315,8 @@ struct DomEvents::Impl {
     if (prefixed && (local == qname + 1 || !plain_name(local) || colon_of(local)))
       return "the element name \"" + std::string(qname) + "\"";
     if (prefixed && !b) return "the unbound prefix of \"" + std::string(qname) + "\"";
+    if (holds_elements(n) && text_element(prefixed ? local : qname))
+      return "the text element \"" + std::string(qname) + "\" holding elements";
     std::size_t count = 0;
     for (pugi::xml_attribute a = n.first_attribute(); a; a = a.next_attribute()) {
       if (++count > kMaxAttributes) return "an element with more than " + std::to_string(kMaxAttributes) + " attributes";

@@ -259,6 +259,11 @@ TEST(CityGmlInMemory, DocumentsPugixmlWouldReadOtherwiseGoToExpat) {
       {"a PI named XML", city(body + "<?XML x?>")},
       {"a local name starting with '.' (fuzz_citygml)", city("<x xlink:.ref=\"a\"/>" + body)},
       {"spaces before the declaration (fuzz_citygml)", "   " + ok},
+      {"coordinates holding elements (fuzz_citygml)",
+       city("<core:cityObjectMember><bldg:Building gml:id=\"c\">" +
+            ground("<gml:Polygon><gml:exterior><gml:LinearRing><gml:posList>0 0 0  <x/>\n  <y/>\n 1 1 0"
+                   "</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon>") +
+            "</bldg:Building></core:cityObjectMember>" + body)},
       {"truncated", ok.substr(0, ok.size() / 2 + 40)},
       {"mismatched end tag", city(body + "<a></b>")},
       {"empty", ""},
