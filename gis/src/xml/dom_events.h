@@ -8,7 +8,9 @@
 //
 // pugixml accepts some documents that expat refuses (entity references it does not know, a DOCTYPE's
 // internal subset, bytes that are not UTF-8, junk after the root, duplicate attributes, unbound
-// prefixes ...). Such a document is refused by load() before any event, with the reason; the caller
+// prefixes, a malformed declaration, names expat refuses ...) or reads them otherwise (the whitespace
+// between elements inside a text element). Such a document is refused by load() before any event,
+// with the reason (fuzz_citygml checks that both read every other document alike); the caller
 // then hands the same bytes to expat, which reports the problem exactly as before. Entities are never
 // expanded here (a DOCTYPE is refused), so entity bombs and external entities stay expat's business,
 // where they are refused too (citygml_reader.cpp).
