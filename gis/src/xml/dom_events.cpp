@@ -257,8 +257,9 @@ struct DomEvents::Impl {
     }
     return nullptr;
   }
-  /// Pushes the element's declarations; "" or why expat would refuse them.
-  std::string open_scope(pugi::xml_node n) {
+  /// Pushes the element's declarations; "" or why expat would refuse them. `names`: also the "URI " strings
+  /// that element names are built from (only the walk that hands out events needs them).
+  std::string open_scope(pugi::xml_node n, bool names) {
     marks.push_back(bindings.size());
     for (pugi::xml_attribute a = n.first_attribute(); a; a = a.next_attribute()) {
       const char* an = a.name();
@@ -273,7 +274,7 @@ struct DomEvents::Impl {
       for (std::size_t k = marks.back(); k < bindings.size(); ++k)
         if (bindings[k].prefix == prefix) return "the namespace declaration " + std::string(an) + " twice";
       Binding b{prefix, uri, std::string()};
-      if (!uri.empty()) b.expanded.append(uri).push_back(' ');
+      if (names && !uri.empty()) b.expanded.append(uri).push_back(' ');
       bindings.push_back(std::move(b));
     }
     return "";
@@ -505,7 +506,7 @@ std::string DomEvents::load(const char* bytes, std::size_t n) {
   m.marks.clear();
   m.traverse(
       [&](pugi::xml_node e) {
-        why = m.open_scope(e);
+        why = m.open_scope(e, false);
         if (why.empty()) why = m.check_element(e);
         return why.empty();
       },
@@ -537,7 +538,7 @@ void DomEvents::walk(Sink& sink) {
   m.line_number = 1;
   m.traverse(
       [&](pugi::xml_node e) {
-        m.open_scope(e);
+        m.open_scope(e, true);
         const char* local;
         bool prefixed;
         const char* qname = e.name();
@@ -547,6 +548,8 @@ void DomEvents::walk(Sink& sink) {
           m.name.assign(b->expanded).append(local);
           name = m.name.c_str();
         }
+        // Room for every attribute's "URI local" name first: growing attr_names later would move the strings
+        // whose c_str() atts already holds.
         std::size_t k = 0;
         for (pugi::xml_attribute a = e.first_attribute(); a; a = a.next_attribute()) ++k;
         if (m.attr_names.size() < k) m.attr_names.resize(k);
