@@ -17,6 +17,7 @@
 #include "citygml/coordinates.h"
 #include "citygml/element_names.h"
 #include "citygml/file_problems.h"
+#include "xml/block_cache.h"
 #include "xml/dom_events.h"
 
 #include <cpl_vsi.h>
@@ -33,6 +34,7 @@
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
+#include <new>
 
 namespace groundplan::gis {
 namespace {
@@ -1063,21 +1065,28 @@ VsiHandle open_file(const std::string& path) {
   return f;
 }
 
-/// Bytes read into memory for the DOM path, without zero-filling them first.
+/// Bytes read into memory for the DOM path, without zero-filling them first, in memory kept by the
+/// thread between documents (xml/block_cache.h).
 class ByteBuffer {
  public:
-  char* data() { return bytes_.get(); }
+  ByteBuffer() = default;
+  ByteBuffer(const ByteBuffer&) = delete;
+  ByteBuffer& operator=(const ByteBuffer&) = delete;
+  ~ByteBuffer() { xml::cached_free(bytes_); }
+  char* data() { return bytes_; }
   std::size_t size() const { return size_; }
   /// Room for `extra` more bytes past size(); returns where they go.
   char* grow(std::size_t extra) {
     if (size_ + extra > capacity_) {
       const std::size_t cap = std::max(size_ + extra, 2 * capacity_);
-      std::unique_ptr<char[]> bigger(new char[cap]);
-      if (size_) std::memcpy(bigger.get(), bytes_.get(), size_);
-      bytes_ = std::move(bigger);
+      char* bigger = static_cast<char*>(xml::cached_alloc(cap));
+      if (!bigger) throw std::bad_alloc();
+      if (size_) std::memcpy(bigger, bytes_, size_);
+      xml::cached_free(bytes_);
+      bytes_ = bigger;
       capacity_ = cap;
     }
-    return bytes_.get() + size_;
+    return bytes_ + size_;
   }
   void append(const char* s, std::size_t n) {
     if (n) std::memcpy(grow(n), s, n);
@@ -1086,7 +1095,7 @@ class ByteBuffer {
   void added(std::size_t n) { size_ += n; }
 
  private:
-  std::unique_ptr<char[]> bytes_;
+  char* bytes_ = nullptr;
   std::size_t size_ = 0, capacity_ = 0;
 };
 

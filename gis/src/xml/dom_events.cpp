@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "xml/dom_events.h"
+#include "xml/block_cache.h"
 
 #include <pugixml.hpp>
 
@@ -450,7 +451,10 @@ struct DomEvents::Impl {
   }
 };
 
-DomEvents::DomEvents() : impl_(std::make_unique<Impl>()) {}
+DomEvents::DomEvents() {
+  use_block_cache_for_pugixml();  // before the first document allocates
+  impl_ = std::make_unique<Impl>();
+}
 DomEvents::~DomEvents() = default;
 
 std::string DomEvents::load(const char* bytes, std::size_t n) {
