@@ -9,6 +9,7 @@
 
 #include "pipeline/file_reading.h"
 #include "pipeline/inputs.h"
+#include "xml/block_cache.h"
 
 #include <cpl_string.h>
 #include <cpl_vsi.h>
@@ -185,7 +186,12 @@ void detail::merge_file(detail::FileRead&& r, const std::string& file, detail::R
   result.timings.footprints_s += r.footprint_wait_s;
   result.buildings_read += r.buildings_read;
   result.buildings_dropped += r.buildings_dropped;
-  std::move(r.footprints.begin(), r.footprints.end(), std::back_inserter(result.footprints));
+  if (result.footprints.empty()) {
+    result.footprints = std::move(r.footprints);  // the first file: no element moved one by one
+  } else {
+    result.footprints.reserve(result.footprints.size() + r.footprints.size());
+    std::move(r.footprints.begin(), r.footprints.end(), std::back_inserter(result.footprints));
+  }
   std::move(r.problems.begin(), r.problems.end(), std::back_inserter(result.problems));
   if (r.failed) {
     ++files_failed;
@@ -260,6 +266,7 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
     for (; fi < files.size(); ++fi)
       detail::merge_file(std::move(reads[fi]), files[fi], context, result, files_failed, first_failure);
   }
+  xml::release_cached_blocks();  // the reading threads' spare memory, before the union needs its own
   if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
   result.timings.read_s = std::max(0.0, seconds_since(t_read) - result.timings.footprints_s);
 
