@@ -33,31 +33,41 @@
 namespace groundplan {
 
 FootprintSet make_footprint_set(const std::vector<Footprint>& footprints) {
+  // Boxes side by side (in the caller's arena), then the admissible ones kept in order.
+  std::vector<FootprintSet::Box> boxes(footprints.size());
+  std::vector<char> kept(footprints.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, footprints.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      FootprintSet::Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
+      bool admissible = true;
+      for (const Polygon& p : footprints[i].polygons) {
+        auto add = [&](const Ring& ring) {
+          for (const Point2& q : ring) {
+            if (!robust::admissible(q)) {  // NaN, inf, 1e300, subnormal: the union refuses it (issue 20)
+              admissible = false;
+              continue;
+            }
+            b.minx = std::min(b.minx, q.x);
+            b.miny = std::min(b.miny, q.y);
+            b.maxx = std::max(b.maxx, q.x);
+            b.maxy = std::max(b.maxy, q.y);
+          }
+        };
+        add(p.outer);
+        for (const Ring& h : p.holes) add(h);
+      }
+      boxes[i] = b;
+      kept[i] = admissible && b.minx <= b.maxx;
+    }
+  });
   FootprintSet s;
   s.footprints = &footprints;
+  s.indices.reserve(footprints.size());
+  s.boxes.reserve(footprints.size());
   for (std::uint32_t i = 0; i < footprints.size(); ++i) {
-    FootprintSet::Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
-    bool admissible = true;
-    for (const Polygon& p : footprints[i].polygons) {
-      auto add = [&](const Ring& r) {
-        for (const Point2& q : r) {
-          if (!robust::admissible(q)) {  // NaN, inf, 1e300, subnormal: the union refuses it (issue 20)
-            admissible = false;
-            continue;
-          }
-          b.minx = std::min(b.minx, q.x);
-          b.miny = std::min(b.miny, q.y);
-          b.maxx = std::max(b.maxx, q.x);
-          b.maxy = std::max(b.maxy, q.y);
-        }
-      };
-      add(p.outer);
-      for (const Ring& h : p.holes) add(h);
-    }
-    if (admissible && b.minx <= b.maxx) {
-      s.indices.push_back(i);
-      s.boxes.push_back(b);
-    }
+    if (!kept[i]) continue;
+    s.indices.push_back(i);
+    s.boxes.push_back(boxes[i]);
   }
   return s;
 }

@@ -27,13 +27,22 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   if (params.resolution_m < 0 || !std::isfinite(params.resolution_m))
     throw InvalidArgument("resolution_m must be >= 0 (0 = automatic), got " + std::to_string(params.resolution_m));
   if (params.threads < 0) throw InvalidArgument("threads must be >= 0 (0 = all cores)");
+  const int threads = params.threads > 0 ? params.threads : tbb::this_task_arena::max_concurrency();
+  tbb::task_arena arena(threads);  // the passes over every footprint below run in it too: serial, they
+                                   // were ~0.1 s of a 16-thread city run (tests/bench/RESULTS.md)
   // Footprints without area or with coordinates the exact arithmetic is not certified for take no
   // part; each is reported (nothing is dropped silently; issue 20: any input gets an answer).
   std::vector<Footprint> const* src = &footprints;
-  const std::vector<char> usable = detail::usable_footprints(footprints, problems);
-  FootprintSet all = make_footprint_set(*src);
+  std::vector<char> usable;
+  FootprintSet all;
+  arena.execute([&] {
+    usable = detail::usable_footprints(footprints, problems);
+    all = make_footprint_set(*src);
+  });
   FootprintSet fps;
   fps.footprints = src;
+  fps.indices.reserve(all.indices.size());
+  fps.boxes.reserve(all.indices.size());
   for (std::size_t k = 0; k < all.indices.size(); ++k) {
     if (!usable[all.indices[k]]) continue;
     fps.indices.push_back(all.indices[k]);
@@ -89,11 +98,9 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     if (progress && std::this_thread::get_id() == caller && (d % 64 == 0 || d == blocks.size()))
       stage.report(static_cast<double>(d) / static_cast<double>(blocks.size()), "union of blocks");
   };
-  const int threads = params.threads > 0 ? params.threads : tbb::this_task_arena::max_concurrency();
   if (threads == 1 || blocks.size() <= 1) {
     for (std::size_t oi = 0; oi < blocks.size(); ++oi) one(oi);
   } else {
-    tbb::task_arena arena(threads);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1),
                         [&](const tbb::blocked_range<std::size_t>& r) {
@@ -101,16 +108,25 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
                         });
     });
   }
-  std::vector<GroundPlan> plans;
-  std::vector<char> member(footprints.size(), 0);
+  // The plans in block order: moved into place side by side (offsets first), problems in order after.
+  std::vector<std::size_t> first(results.size() + 1, 0);
+  for (std::size_t bi = 0; bi < results.size(); ++bi) first[bi + 1] = first[bi] + results[bi].plans.size();
+  std::vector<GroundPlan> plans(first.back());
+  std::vector<char> member(footprints.size(), 0);  // a footprint is in one block: no two blocks write one entry
   std::vector<char> failed(footprints.size(), 0);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, results.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t bi = r.begin(); bi != r.end(); ++bi) {
+        std::size_t at = first[bi];
+        for (GroundPlan& g : results[bi].plans) {
+          for (std::uint32_t m : g.members) member[m] = 1;
+          plans[at++] = std::move(g);
+        }
+      }
+    });
+  });
   for (std::size_t bi = 0; bi < results.size(); ++bi) {
-    detail::BlockResult& r = results[bi];
-    for (GroundPlan& g : r.plans) {
-      for (std::uint32_t m : g.members) member[m] = 1;
-      plans.push_back(std::move(g));
-    }
-    for (Problem& p : r.problems) {
+    for (Problem& p : results[bi].problems) {
       if (p.code == "UNION_FAILED")
         for (std::uint32_t fi : blocks[bi].footprints) failed[fi] = 1;
       problems.push_back(std::move(p));

@@ -2,6 +2,8 @@
 // Footprints the union refuses, each named by a Problem (union/input_check.h, issue 20).
 #include "union/input_check.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -65,15 +67,16 @@ bool coordinates_admissible(const Footprint& footprint) { return first_bad_coord
 
 std::vector<char> usable_footprints(const std::vector<Footprint>& footprints, std::vector<Problem>& problems) {
   std::vector<char> usable(footprints.size(), 0);
+  // Checked side by side (in the caller's arena); the few refused are named in order after.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, footprints.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      usable[i] = coordinates_admissible(footprints[i]) && has_area(footprints[i]);
+  });
   for (std::size_t i = 0; i < footprints.size(); ++i) {
+    if (usable[i]) continue;
     const Footprint& f = footprints[i];
     Defect d = first_bad_coordinate(f);
-    if (d.code.empty() && !has_area(f))
-      d = {"NO_AREA", "the footprint has no area (fewer than three non-collinear points): not in any plan"};
-    if (d.code.empty()) {
-      usable[i] = 1;
-      continue;
-    }
+    if (d.code.empty()) d = {"NO_AREA", "the footprint has no area (fewer than three non-collinear points): not in any plan"};
     problems.push_back(Problem{f.source_id, f.source_file, "union", std::move(d.code), std::move(d.reason)});
   }
   return usable;

@@ -194,7 +194,8 @@ TEST(Pipeline, FootprintsMadeInParallelComeOutInReadingOrder) {
     } else {
       for (int side = 0; side < 6; ++side) gml += ring(x0, y0, x1, y1, 40, 48, side);
       if (i % 3 == 2)
-        gml += "<gml:surfaceMember><gml:Polygon><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">" +
+        gml += "<gml:surfaceMember><gml:Polygon gml:id=\"P" + std::to_string(i) +  // an id: not named by its line,
+               "\"><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">" +  // so chunks may read it
                std::to_string(x0) + " 5860000 48 " + std::to_string(x1) + " 5860000 48 " + std::to_string(x0) +
                " 5860000 48</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember>\n";
     }
@@ -208,27 +209,38 @@ TEST(Pipeline, FootprintsMadeInParallelComeOutInReadingOrder) {
     std::fwrite(gml.data(), 1, gml.size(), f);
     std::fclose(f);
   }
-  gis::PipelineOptions options;
-  options.inputs = {file.string()};
-  const gis::PipelineResult r = gis::run_pipeline(options);
+  // Read whole, and in chunks of 64 KiB side by side (their parts appended in parallel, file_reading.cpp).
+  for (const std::int64_t chunk : {std::int64_t{0}, std::int64_t{1} << 16}) {
+    SCOPED_TRACE("read_chunk_bytes " + std::to_string(chunk));
+    gis::PipelineOptions options;
+    options.inputs = {file.string()};
+    options.read_chunk_bytes = chunk;
+    options.threads = 2;
+    const gis::PipelineResult r = gis::run_pipeline(options);
+    EXPECT_EQ(r.reading.chunks, chunk ? 15u : 0u) << (r.reading.read_whole.empty() ? std::string() : r.reading.read_whole[0].second);
+
+    std::vector<std::string> want_fp;
+    for (int i = 0; i < n; ++i)
+      if (i % 3 != 1) want_fp.push_back("B" + std::to_string(i));
+    std::vector<std::string> got_fp;
+    for (const Footprint& f : r.footprints) {
+      got_fp.push_back(f.source_id);
+      EXPECT_EQ(f.source_file, file.string()) << f.source_id;
+      EXPECT_EQ(f.method, "solid-bottom") << f.source_id;  // lod1Solid boxes
+    }
+    EXPECT_EQ(got_fp, want_fp);
+
+    // Problems naming buildings, in order: B1 (footprint), B2 (read), B4 (footprint), B5 (read), ...
+    std::vector<std::string> want_pb, got_pb;
+    for (int i = 0; i < n; ++i)
+      if (i % 3 != 0) want_pb.push_back("B" + std::to_string(i) + (i % 3 == 1 ? " footprint" : " read"));
+    for (const Problem& p : r.problems)
+      if (!p.source_id.empty()) got_pb.push_back(p.source_id + " " + p.stage);
+    EXPECT_EQ(got_pb, want_pb);
+    EXPECT_EQ(r.buildings_read, static_cast<std::size_t>(n));
+    EXPECT_EQ(r.buildings_dropped, static_cast<std::size_t>(n / 3));
+  }
   fs::remove(file);
-
-  std::vector<std::string> want_fp;
-  for (int i = 0; i < n; ++i)
-    if (i % 3 != 1) want_fp.push_back("B" + std::to_string(i));
-  std::vector<std::string> got_fp;
-  for (const Footprint& f : r.footprints) got_fp.push_back(f.source_id);
-  EXPECT_EQ(got_fp, want_fp);
-
-  // Problems naming buildings, in order: B1 (footprint), B2 (read), B4 (footprint), B5 (read), ...
-  std::vector<std::string> want_pb, got_pb;
-  for (int i = 0; i < n; ++i)
-    if (i % 3 != 0) want_pb.push_back("B" + std::to_string(i) + (i % 3 == 1 ? " footprint" : " read"));
-  for (const Problem& p : r.problems)
-    if (!p.source_id.empty()) got_pb.push_back(p.source_id + " " + p.stage);
-  EXPECT_EQ(got_pb, want_pb);
-  EXPECT_EQ(r.buildings_read, static_cast<std::size_t>(n));
-  EXPECT_EQ(r.buildings_dropped, static_cast<std::size_t>(n / 3));
 }
 
 }  // namespace
