@@ -8,7 +8,9 @@
 #   [SECTIONS="same e2e index alloc copy scaling xml bench"] tests/bench/city_scale_on_device.sh BUNDLE.tar.xz [CITY_MB] [BIG_CITY_MB]
 # SECTIONS picks what runs (default: all but xml and bench); "xml" times the CityGML reader in memory (pugixml,
 # the default) against streamed through expat (--config GROUNDPLAN_XML_IN_MEMORY_BYTES 0) in alternated rounds,
-# "bench" runs citygml_read_bench (packed with PACK_EXTRA_BINS) on two real samples and a 60 MB generated city.
+# "bench" runs citygml_read_bench (packed with PACK_EXTRA_BINS) on two real samples and a 60 MB generated city;
+# "ab" alternates this build with another CLI packed beside it (AB_BIN=groundplan_before, a path given to
+# PACK_EXTRA_BINS) on the same inputs, and compares their outputs.
 set -u
 BUNDLE=${1:?BUNDLE}; MB=${2:-1500}; BIG_MB=${3:-0}
 SECTIONS=${SECTIONS:-"same e2e index alloc copy scaling"}
@@ -38,7 +40,7 @@ PY
 gp() {  # NAME ARGS... : one run, its line
   local name=$1; shift
   rm -rf "$W/$name.gpkg" "$W/$name.csv"
-  /usr/bin/time -f "%e %U %S %M" -o "$W/$name.time" $G/bin/groundplan -q --device cpu --stats "$W/$name.json" "$@"
+  /usr/bin/time -f "%e %U %S %M" -o "$W/$name.time" $G/bin/${GP_BIN:-groundplan} -q --device cpu --stats "$W/$name.json" "$@"
   local rc=$?
   [ $rc = 0 ] && line "$name" "$W/$name.json" "$W/$name.time" || echo "$name: exit $rc"
 }
@@ -80,6 +82,22 @@ if want xml; then
 import json, sys
 print("xml_streamed of the in-memory run:", json.load(open(sys.argv[1]))["reading"].get("xml_streamed"))
 PY
+fi
+if want ab && [ -x "$G/bin/${AB_BIN:-none}" ]; then
+  echo "== this build (new) against $AB_BIN (old), alternated rounds; the same outputs"
+  for i in 1 2 3; do
+    GP_BIN=$AB_BIN gp "old_file_$i" -f GPKG "$W/old_file_$i.gpkg" "$W/city.gml"
+    gp "new_file_$i" -f GPKG "$W/new_file_$i.gpkg" "$W/city.gml"
+    GP_BIN=$AB_BIN gp "old_tiles_$i" -f GPKG "$W/old_tiles_$i.gpkg" "$W/tiles" --tiles off
+    gp "new_tiles_$i" -f GPKG "$W/new_tiles_$i.gpkg" "$W/tiles" --tiles off
+  done
+  GP_BIN=$AB_BIN gp old_t1 -f GPKG "$W/old_t1.gpkg" "$W/city.gml" --threads 1
+  gp new_t1 -f GPKG "$W/new_t1.gpkg" "$W/city.gml" --threads 1
+  for t in 2 4 8; do gp "new_scale_t$t" -f GPKG "$W/new_scale_t$t.gpkg" "$W/city.gml" --threads $t; done
+  GP_BIN=$AB_BIN gp old_csv -f CSV -lco GEOMETRY=AS_WKT "$W/old_csv.csv" "$W/city.gml"
+  gp new_csv -f CSV -lco GEOMETRY=AS_WKT "$W/new_csv.csv" "$W/city.gml"
+  gp new_csv_tiles -f CSV -lco GEOMETRY=AS_WKT "$W/new_csv_tiles.csv" "$W/tiles" --tiles off
+  md5sum "$W"/old_csv.csv "$W"/new_csv.csv "$W"/new_csv_tiles.csv | sed "s#$W/##"
 fi
 if want bench && [ -x $G/bin/citygml_read_bench ]; then
   echo "== one core: citygml_read_bench (CPU-time medians), two real samples and a 60 MB city of the generator"
@@ -139,6 +157,10 @@ if [ "$BIG_MB" != 0 ]; then
   s=$(date +%s); python3 tests/bench/gen_big_citygml.py "$W/big.gml" "$BIG_MB" | tail -1; echo "  made in $(( $(date +%s) - s )) s"
   cat "$W/big.gml" > /dev/null
   gp big_all -f GPKG "$W/big_all.gpkg" "$W/big.gml"
+  if want ab && [ -x "$G/bin/${AB_BIN:-none}" ]; then
+    GP_BIN=$AB_BIN gp big_old -f GPKG "$W/big_old.gpkg" "$W/big.gml"
+    gp big_all_2 -f GPKG "$W/big_all_2.gpkg" "$W/big.gml"
+  fi
   if want xml; then
     gp big_all_2 -f GPKG "$W/big_all_2.gpkg" "$W/big.gml"
     gp big_expat -f GPKG "$W/big_expat.gpkg" "$W/big.gml" --config GROUNDPLAN_XML_IN_MEMORY_BYTES 0
