@@ -84,8 +84,8 @@ print("xml_streamed of the in-memory run:", json.load(open(sys.argv[1]))["readin
 PY
 fi
 if want ab && [ -x "$G/bin/${AB_BIN:-none}" ]; then
-  echo "== this build (new) against $AB_BIN (old), alternated rounds; the same outputs"
-  for i in 1 2 3; do
+  echo "== this build (new) against $AB_BIN (old), ${ROUNDS:-3} alternated rounds; the same outputs"
+  for i in $(seq ${ROUNDS:-3}); do
     GP_BIN=$AB_BIN gp "old_file_$i" -f GPKG "$W/old_file_$i.gpkg" "$W/city.gml"
     gp "new_file_$i" -f GPKG "$W/new_file_$i.gpkg" "$W/city.gml"
     GP_BIN=$AB_BIN gp "old_tiles_$i" -f GPKG "$W/old_tiles_$i.gpkg" "$W/tiles" --tiles off
