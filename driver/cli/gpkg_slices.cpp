@@ -136,50 +136,49 @@ std::string slices_ruled_out(const std::vector<std::string>& flags, const std::v
 
 void sqlite_without_memory_statistics() { sqlite3_config(SQLITE_CONFIG_MEMSTATUS, 0); }
 
-int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
-                 const std::string& plans_layer, std::size_t plans, int threads, std::string* why_one) {
-  auto one = [&](std::string why) {
-    if (why_one) *why_one = std::move(why);
-    return 1;
-  };
+int writers_for(std::size_t plans, int threads, std::string* why_one) {
   const int by_plans = static_cast<int>(std::min<std::size_t>(plans / kPlansPerWriter, kMaxWriters));
   const int writers = std::min(threads, by_plans);
-  if (writers < 2)
-    return one(threads < 2 ? "one thread" : "fewer than " + std::to_string(2 * kPlansPerWriter) + " plans");
+  if (writers >= 2) return writers;
+  if (why_one) *why_one = threads < 2 ? "one thread" : "fewer than " + std::to_string(2 * kPlansPerWriter) + " plans";
+  return 1;
+}
+
+int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::string>& layers,
+                 const std::string& plans_layer, std::size_t plans, int threads, std::string* why_one) {
+  const int writers = writers_for(plans, threads, why_one);
+  if (writers < 2) return 1;
   std::string why = slices_ruled_out(flags, layers, plans_layer);
-  if (!why.empty()) return one(std::move(why));
+  if (!why.empty()) {
+    if (why_one) *why_one = std::move(why);
+    return 1;
+  }
   return writers;
 }
 
-SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate) {
-  using clock = std::chrono::steady_clock;
-  SliceOutcome out;
-  const int k_max = std::max(1, w.writers);
-  const std::filesystem::path dst(w.dst);
-  std::vector<std::string> parts;  // slices 1 .. k_max - 1
-  for (int k = 1; k < k_max; ++k)
-    parts.push_back((dst.parent_path() / ("." + dst.stem().string() + ".slice" + std::to_string(k) + "-" +
-                                          std::to_string(::getpid()) + ".gpkg"))
-                        .string());
-  for (const auto& p : parts) remove_with_sidecars(p);
+std::size_t slice_start(std::size_t plans, int k, int writers) {
+  return plans * static_cast<std::size_t>(k) / static_cast<std::size_t>(writers);
+}
 
+bool write_slices_side_by_side(const SliceWrite& w, const SliceSource& source, const Translate& translate,
+                               const std::vector<std::string>& paths, const std::vector<std::string>& extra,
+                               SliceOutcome& out) {
+  using clock = std::chrono::steady_clock;
+  const int k_max = static_cast<int>(paths.size());
   const auto t0 = clock::now();
-  std::vector<char> ok(static_cast<std::size_t>(k_max), 0);
-  std::vector<int> usage(static_cast<std::size_t>(k_max), 0);
+  std::vector<char> ok(paths.size(), 0);
+  std::vector<int> usage(paths.size(), 0);
   auto write_slice = [&](int k) {
-    const std::size_t first = w.plans * static_cast<std::size_t>(k) / static_cast<std::size_t>(k_max);
-    const std::size_t last = w.plans * static_cast<std::size_t>(k + 1) / static_cast<std::size_t>(k_max);
-    GDALDatasetH src = source(first, last);
+    GDALDatasetH src = source(slice_start(w.plans, k, k_max), slice_start(w.plans, k + 1, k_max));
     if (!src) return;
     std::vector<std::string> args = w.flags;
-    args.push_back("-preserve_fid");  // the source's FIDs are the plans' indices + 1: slices append in order
+    args.insert(args.end(), extra.begin(), extra.end());
     if (k == 0)
       args.insert(args.end(), w.layers.begin(), w.layers.end());
     else
       args.push_back(w.plans_layer);
     int ue = 0;
-    ok[static_cast<std::size_t>(k)] =
-        translate(k == 0 ? w.dst : parts[static_cast<std::size_t>(k - 1)], src, args, w.progress && k == 0, &ue);
+    ok[static_cast<std::size_t>(k)] = translate(paths[static_cast<std::size_t>(k)], src, args, w.progress && k == 0, &ue);
     usage[static_cast<std::size_t>(k)] = ue;
     GDALClose(src);
   };
@@ -191,15 +190,34 @@ SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, c
   }
   out.slices_s = std::chrono::duration<double>(clock::now() - t0).count();
   out.usage_error = *std::max_element(usage.begin(), usage.end());
+  for (int k = 0; k < k_max; ++k)
+    if (!ok[static_cast<std::size_t>(k)]) {
+      out.error = "writing slice " + std::to_string(k) + " of the plans failed";
+      return false;
+    }
+  return true;
+}
 
+SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate) {
+  using clock = std::chrono::steady_clock;
+  SliceOutcome out;
+  const int k_max = std::max(1, w.writers);
+  const std::filesystem::path dst(w.dst);
+  std::vector<std::string> paths = {w.dst};  // slice 0 straight into the destination; the others beside it
+  for (int k = 1; k < k_max; ++k)
+    paths.push_back((dst.parent_path() / ("." + dst.stem().string() + ".slice" + std::to_string(k) + "-" +
+                                          std::to_string(::getpid()) + ".gpkg"))
+                        .string());
+  const std::vector<std::string> parts(paths.begin() + 1, paths.end());
+  for (const auto& p : parts) remove_with_sidecars(p);
   auto fail = [&](std::string why) {
     out.error = std::move(why);
     for (const auto& p : parts) remove_with_sidecars(p);
     remove_with_sidecars(w.dst);
     return out;
   };
-  for (int k = 0; k < k_max; ++k)
-    if (!ok[static_cast<std::size_t>(k)]) return fail("writing slice " + std::to_string(k) + " of the plans failed");
+  // The source's FIDs are the plans' indices + 1: slices append in order.
+  if (!write_slices_side_by_side(w, source, translate, paths, {"-preserve_fid"}, out)) return fail(out.error);
 
   const auto t1 = clock::now();
   try {

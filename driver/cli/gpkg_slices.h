@@ -86,4 +86,18 @@ struct SliceOutcome {
 /// `w.dst` nor beside it.
 SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate);
 
+/// The slices' common step: slice k of the plans layer (of w.writers, in plan order) written to paths[k] by its
+/// own ogr2ogr, all side by side, slice 0 with w.layers (and the progress), the others with the plans layer alone;
+/// `extra`: options added to w.flags. Sets out.slices_s and out.usage_error; false when a slice failed.
+bool write_slices_side_by_side(const SliceWrite& w, const SliceSource& source, const Translate& translate,
+                               const std::vector<std::string>& paths, const std::vector<std::string>& extra,
+                               SliceOutcome& out);
+
+/// Which plans layer slice [first, last) of `plans` in `writers` is: k's share is plans * k / writers onwards.
+std::size_t slice_start(std::size_t plans, int k, int writers);
+
+/// How many writers a plans layer of `plans` features gets on `threads` threads (the same rule for every format
+/// written in slices); 1 and `why_one` when fewer than two.
+int writers_for(std::size_t plans, int threads, std::string* why_one);
+
 }  // namespace groundplan::cli

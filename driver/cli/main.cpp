@@ -5,6 +5,7 @@
 #include "ogr_groundplan.h"
 #include "open_options.h"
 #include "gpkg_rtree.h"
+#include "csv_slices.h"
 #include "gpkg_slices.h"
 #include "preview.h"
 #ifdef GROUNDPLAN_WITH_MPI
@@ -376,12 +377,17 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
   int usage_error = FALSE;
   bool write_ok = false;
   const int n_threads = static_cast<int>(groundplan::gis::thread_count(threads));
-  std::string why_one = "not a new GeoPackage";
+  std::string why_one = "not a new GeoPackage or CSV file";
   int writers = 1;
-  if (own_index && another) {
+  // A new GeoPackage or CSV file: the plans written by several writers side by side (gpkg_slices.h, csv_slices.h).
+  std::error_code exists_ec;
+  const bool csv = !own_index && groundplan::cli::is_csv_file(ogr.format, ogr.dst) &&
+                   !std::filesystem::exists(ogr.dst, exists_ec);
+  if ((own_index || csv) && another) {
     auto* plans_layer = ds->layer("ground_plans");
     const std::size_t plans = plans_layer ? static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE)) : 0;
-    writers = groundplan::cli::gpkg_writers(flags, layers, "ground_plans", plans, n_threads, &why_one);
+    writers = csv ? groundplan::cli::csv_writers(flags, layers, "ground_plans", plans, n_threads, &why_one)
+                  : groundplan::cli::gpkg_writers(flags, layers, "ground_plans", plans, n_threads, &why_one);
     if (writers > 1) {
       groundplan::cli::SliceWrite sw;
       sw.dst = ogr.dst;
@@ -391,18 +397,17 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
       sw.writers = writers;
       sw.progress = ogr.progress && !ogr.quiet;
       const int per_writer = std::max(1, n_threads / writers);
-      const auto slice = groundplan::cli::write_gpkg_slices(
-          sw,
-          [&](std::size_t first, std::size_t last) -> GDALDatasetH {
-            auto* d = another(per_writer);
-            if (!d || !d->layer("ground_plans")) {
-              delete d;
-              return nullptr;  // that slice fails, and so the write (gpkg_slices.h)
-            }
-            d->layer("ground_plans")->restrict_to(first, last);
-            return GDALDataset::ToHandle(d);
-          },
-          vector_translate);
+      const groundplan::cli::SliceSource source = [&](std::size_t first, std::size_t last) -> GDALDatasetH {
+        auto* d = another(per_writer);
+        if (!d || !d->layer("ground_plans")) {
+          delete d;
+          return nullptr;  // that slice fails, and so the write (gpkg_slices.h)
+        }
+        d->layer("ground_plans")->restrict_to(first, last);
+        return GDALDataset::ToHandle(d);
+      };
+      const auto slice = csv ? groundplan::cli::write_csv_slices(sw, source, vector_translate)
+                             : groundplan::cli::write_gpkg_slices(sw, source, vector_translate);
       write_ok = slice.ok;
       usage_error = slice.usage_error;
       if (!slice.ok) std::fprintf(stderr, "groundplan: %s\n", slice.error.c_str());

@@ -18,37 +18,6 @@ SCHEMA = "SELECT type, name, tbl_name, sql FROM sqlite_master ORDER BY type, nam
 CONTENTS = "SELECT table_name, data_type, identifier, min_x, min_y, max_x, max_y, srs_id FROM gpkg_contents ORDER BY 1"
 
 
-def square(x, y, s):
-    return [[x, y], [x + s, y], [x + s, y + s], [x, y + s], [x, y]]
-
-
-@pytest.fixture(scope="module")
-def parts(tmp_path_factory):
-    """About 44,000 building parts in EPSG:25832 (a grid of squares, some overlapping a neighbour, some with a
-    courtyard) and a few degenerate ones (problems): about 35,000 plans (pairs of cells joined), enough for four writers."""
-    features = []
-    for i in range(220):
-        for j in range(180):
-            x, y = 400000.0 + 10 * i, 5800000.0 + 10 * j
-            rings = [square(x, y, 8.0)]
-            if (i * j) % 13 == 5:
-                rings.append(square(x + 3, y + 3, 2.0)[::-1])
-            features.append({"type": "Feature", "properties": {"id": f"b{i}_{j}"},
-                             "geometry": {"type": "Polygon", "coordinates": rings}})
-            if (i + j) % 9 == 0:  # a second part overlapping this one and the next cell's
-                features.append({"type": "Feature", "properties": {"id": f"p{i}_{j}"},
-                                 "geometry": {"type": "Polygon", "coordinates": [square(x + 5, y + 2, 6.5)]}})
-    for k in range(5):  # no area: each a problem, nothing written for it
-        x = 399000.0 + 10 * k
-        features.append({"type": "Feature", "properties": {"id": f"flat{k}"},
-                         "geometry": {"type": "Polygon", "coordinates": [[[x, 0], [x + 1, 0], [x + 2, 0], [x, 0]]]}})
-    path = tmp_path_factory.mktemp("writers") / "parts.geojson"
-    path.write_text(json.dumps({"type": "FeatureCollection",
-                                "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::25832"}},
-                                "features": features}))
-    return path
-
-
 def write(folder, name, src, threads, *args):
     out, stats = folder / f"{name}.gpkg", folder / f"{name}.json"
     run([BIN, "-q", "--threads", str(threads), "--stats", stats, "-f", "GPKG", out, src, *args])
