@@ -61,7 +61,16 @@ def test_an_exception_in_the_callback_propagates():
     assert groundplan.union(city(10)).plans
 
 
-def test_ctrl_c_raises_keyboard_interrupt():
+@pytest.fixture
+def default_sigint():
+    """Python's own Ctrl-C handler for the test: a process started in the background by a shell without job
+    control inherits SIGINT ignored, and Python then installs none (a CI run started so failed here, 2026-11-25)."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
+def test_ctrl_c_raises_keyboard_interrupt(default_sigint):
     """SIGINT while the engine works (no Python callback that could run the handler): the call stops early."""
     wkbs = [g.wkb for g in big_city()]
     kw = dict(threads=0, resolution=0, device="auto", snap=0, close_gaps=0, simplify=0, min_hole_area=0, min_area=0,
