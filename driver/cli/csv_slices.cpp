@@ -2,7 +2,6 @@
 #include "csv_slices.h"
 
 #include <cpl_string.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -80,23 +79,16 @@ int csv_writers(const std::vector<std::string>& flags, const std::vector<std::st
 SliceOutcome write_csv_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate) {
   using clock = std::chrono::steady_clock;
   SliceOutcome out;
-  const std::filesystem::path dst(w.dst);
-  std::vector<std::string> paths = {w.dst};  // slice 0 straight into the destination; the others beside it
-  for (int k = 1; k < std::max(1, w.writers); ++k)
-    paths.push_back((dst.parent_path() / ("." + dst.stem().string() + ".slice" + std::to_string(k) + "-" +
-                                          std::to_string(::getpid()) + ".csv"))
-                        .string());
+  const std::vector<std::string> paths = slice_paths(w.dst, std::max(1, w.writers), ".csv");
   const std::vector<std::string> parts(paths.begin() + 1, paths.end());
   auto remove_parts = [&] {
-    std::error_code ec;
-    for (const auto& p : parts) std::filesystem::remove(p, ec);
+    for (const auto& p : parts) remove_with_sidecars(p);
   };
   remove_parts();
   auto fail = [&](std::string why) {
     out.error = std::move(why);
     remove_parts();
-    std::error_code ec;
-    std::filesystem::remove(w.dst, ec);
+    remove_with_sidecars(w.dst);
     return out;
   };
   if (!write_slices_side_by_side(w, source, translate, paths, {}, out)) return fail(out.error);

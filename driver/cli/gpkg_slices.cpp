@@ -156,6 +156,16 @@ int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::s
   return writers;
 }
 
+std::vector<std::string> slice_paths(const std::string& dst, int writers, const std::string& ext) {
+  const std::filesystem::path d(dst);
+  std::vector<std::string> paths = {dst};
+  for (int k = 1; k < writers; ++k)
+    paths.push_back((d.parent_path() / ("." + d.stem().string() + ".slice" + std::to_string(k) + "-" +
+                                        std::to_string(::getpid()) + ext))
+                        .string());
+  return paths;
+}
+
 std::size_t slice_start(std::size_t plans, int k, int writers) {
   return plans * static_cast<std::size_t>(k) / static_cast<std::size_t>(writers);
 }
@@ -202,12 +212,7 @@ SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, c
   using clock = std::chrono::steady_clock;
   SliceOutcome out;
   const int k_max = std::max(1, w.writers);
-  const std::filesystem::path dst(w.dst);
-  std::vector<std::string> paths = {w.dst};  // slice 0 straight into the destination; the others beside it
-  for (int k = 1; k < k_max; ++k)
-    paths.push_back((dst.parent_path() / ("." + dst.stem().string() + ".slice" + std::to_string(k) + "-" +
-                                          std::to_string(::getpid()) + ".gpkg"))
-                        .string());
+  const std::vector<std::string> paths = slice_paths(w.dst, k_max, ".gpkg");
   const std::vector<std::string> parts(paths.begin() + 1, paths.end());
   for (const auto& p : parts) remove_with_sidecars(p);
   auto fail = [&](std::string why) {

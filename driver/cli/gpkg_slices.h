@@ -41,7 +41,7 @@ std::string slices_ruled_out(const std::vector<std::string>& flags, const std::v
 /// The plans layer's table name: `plans_layer`, or what -nln says.
 std::string table_name(const std::vector<std::string>& flags, const std::string& plans_layer);
 
-/// Removes a SQLite file and its journal files (nothing said when they are not there).
+/// Removes a file and the journal files SQLite may leave beside it (nothing said when they are not there).
 void remove_with_sidecars(const std::string& path);
 
 /// Rows of one table of a slice file to append to the destination: those with FIDs (rowids) first..last, or all
@@ -92,6 +92,10 @@ SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, c
 bool write_slices_side_by_side(const SliceWrite& w, const SliceSource& source, const Translate& translate,
                                const std::vector<std::string>& paths, const std::vector<std::string>& extra,
                                SliceOutcome& out);
+
+/// Where the `writers` slices of a new `dst` are written: dst itself for slice 0, the others hidden beside it
+/// (".<stem>.slice<k>-<pid><ext>").
+std::vector<std::string> slice_paths(const std::string& dst, int writers, const std::string& ext);
 
 /// Which plans layer slice [first, last) of `plans` in `writers` is: k's share is plans * k / writers onwards.
 std::size_t slice_start(std::size_t plans, int k, int writers);

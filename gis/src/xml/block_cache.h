@@ -23,7 +23,7 @@ void cached_free(void* p);
 /// Frees what every thread's cache holds (the pipeline calls it when reading is done, so that the
 /// union and the writer do not run beside memory nobody uses).
 void release_cached_blocks();
-/// Bytes held by all caches now (for tests and --stats).
+/// Bytes held by all caches now (for the tests).
 std::size_t cached_bytes();
 
 /// Makes pugixml allocate through cached_alloc / cached_free. Idempotent; called before the first
