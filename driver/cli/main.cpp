@@ -611,7 +611,12 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
     std::fprintf(stderr, "groundplan: could not write %s: %s\n", ogr.dst.c_str(), w.why.c_str());
     return 1;
   }
-  const int rc = write_tiled_stats(stats_path, r, plans, w.write_s, 0, nullptr, seconds_since(t0),
+  WriteOutcome wo;  // --stats "writer": where the tables were made before they went into the user's schema
+  wo.ok = true;
+  wo.writer = {{"writers", ranks.size()}, {"every_rank_writes", true}};
+  if (w.in_place.empty()) wo.writer["staging_schema"] = w.staging_schema;
+  else wo.writer["tables_made_in_place"] = w.in_place;
+  const int rc = write_tiled_stats(stats_path, r, plans, w.write_s, 0, &wo, seconds_since(t0),
                                    groundplan::gis::process_cpu_seconds() - cpu0) ? 0 : 1;
   if (!ogr.quiet) print_tiled_summary(r, ogr, ogr.dst + " (every rank its own plans)", plans, seconds_since(t0), w.write_s);
   return rc;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "rank_writes.h"
 
+#include "pg_staging.h"
+
 #include <cpl_error.h>
 #include <cpl_string.h>
 #include <gdal_utils.h>
@@ -181,18 +183,34 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   const auto t0 = std::chrono::steady_clock::now();
   RankWrite w;
 
-  // 1. Rank 0 makes the tables (with the user's options: -overwrite, -lco ...); the others wait for its word. It
-  // notes which of them were there before: on failure it drops the others (made by this run) again.
+  // 1. Rank 0 makes the tables (with the user's options: -overwrite, -lco ...); the others wait for its word. Where
+  // it can, it makes them in a staging schema (pg_staging.h), moved into the user's schema only in step 4. Otherwise
+  // it notes which of them were there before: on failure it drops the others (made by this run) again.
   const CPLStringList doo = open_options(setup.options);
+  const bool overwrite = std::find(setup.options.begin(), setup.options.end(), "-overwrite") != setup.options.end();
   std::string created;
   std::optional<std::vector<std::string>> before;
-  if (ex.rank() == 0 && setup.create) before = existing_tables(setup.dst, doo, setup.tables, false);
+  std::optional<PgStaging> staging;
+  if (ex.rank() == 0 && setup.create) {
+    before = existing_tables(setup.dst, doo, setup.tables, false);
+    w.in_place = why_tables_in_place(setup.dst, setup.options, setup.tables, before);
+    std::string no_schema;
+    if (w.in_place.empty()) staging = make_staging_schema(setup.dst, doo, &no_schema);
+    if (w.in_place.empty() && !staging) w.in_place = no_schema;  // e.g. no CREATE right on the database
+    if (staging) w.staging_schema = staging->schema;
+  }
   if (ex.rank() == 0)
     created = !setup.create ? std::string("nothing to write")
-                            : translate(setup.dst, nullptr, empty_layers, setup.options);
+                            : translate(staging ? staging->staged_dst() : setup.dst, nullptr, empty_layers,
+                                        setup.options);
   GDALClose(GDALDataset::ToHandle(empty_layers));
   // Only a datasource seen before the run tells what it made; one that could not be opened is left alone.
   auto drop_made = [&] {
+    if (staging) {
+      const std::string why = drop_staging_schema(*staging, doo);
+      if (!why.empty()) return "; the staging schema " + staging->schema + " holding this run's tables stays: " + why;
+      return "; the tables this run made are dropped (staging schema " + staging->schema + ")";
+    }
     if (before) w.dropped = drop_made_tables(setup.dst, doo, setup.tables, *before);
     std::string list;
     for (const std::string& t : w.dropped) list += (list.empty() ? "" : ", ") + t;
@@ -206,16 +224,19 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     w.write_s = seconds_since(t0);
     return w;
   }
+  // Where every rank writes: the staging schema, or the user's.
+  const std::string write_dst = gather_text(ex, ex.rank() == 0 && staging ? staging->staged_dst() : "").at(0);
 
   // 2. Every rank adds its share in one transaction of its own, not committed yet.
   std::string wrote;
   const char* const drivers[] = {"PostgreSQL", nullptr};
   CPLErrorReset();
-  GDALDatasetH dst = GDALOpenEx(setup.dst.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE | GDAL_OF_VERBOSE_ERROR, drivers,
+  const std::string& into = write_dst.empty() ? setup.dst : write_dst;
+  GDALDatasetH dst = GDALOpenEx(into.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE | GDAL_OF_VERBOSE_ERROR, drivers,
                                 doo.List(), nullptr);
   bool in_transaction = false;
   if (!dst) {
-    wrote = "cannot open " + setup.dst + ": " + gdal_error("no PostgreSQL datasource");
+    wrote = "cannot open " + into + ": " + gdal_error("no PostgreSQL datasource");
   } else if (!wait_for_locks_at_most(dst, kLockTimeout)) {
     wrote = "cannot set lock_timeout: " + gdal_error("the server refused");
   } else if (GDALDatasetStartTransaction(dst, FALSE) != OGRERR_NONE) {
@@ -223,7 +244,7 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   } else {
     in_transaction = true;
     HeldTransaction held(GDALDataset::FromHandle(dst));
-    wrote = translate(setup.dst, GDALDataset::ToHandle(&held), mine, append_options(setup.options));
+    wrote = translate(into, GDALDataset::ToHandle(&held), mine, append_options(setup.options));
   }
   GDALClose(GDALDataset::ToHandle(mine));
   // A rank that throws here (a fault, or the test hook) is a rank that failed to write: every rank rolls back.
@@ -257,6 +278,17 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     w.why = not_committed + " (the other ranks' rows are committed: the tables are incomplete)";
     if (ex.rank() == 0) w.why += drop_made();
     return w;
+  }
+  // 4. Rank 0 moves the staged tables into the user's schema, in one transaction (replacing the old ones under
+  // -overwrite): only now does the user's schema hold anything of the run.
+  if (ex.rank() == 0 && staging) {
+    const std::string why = move_staged_tables(*staging, doo, overwrite);
+    w.write_s = seconds_since(t0);
+    if (!why.empty()) {
+      w.why = "cannot move the tables from the staging schema " + staging->schema + " into " + staging->target +
+              ": " + why + " (schema " + staging->target + " is as it was)" + drop_made();
+      return w;
+    }
   }
   w.ok = true;
   return w;

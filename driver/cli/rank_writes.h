@@ -5,6 +5,8 @@
 // ogr2ogr options: -lco, -overwrite, -nln ...), every rank then appends its share in one transaction of its own, and
 // the transactions are committed only once every rank has written all of its rows (an allgather of their outcome):
 // a rank that dies before leaves every transaction open, and PostgreSQL rolls them back when mpirun ends the job.
+// Where it can, rank 0 makes the tables in a staging schema and moves them into the user's schema in one
+// transaction after every commit (pg_staging.h), so a run that dies leaves nothing under the names asked for.
 // docs/ARCHITECTURE.md ("Many machines") says what is left for a rank that dies inside the commits.
 #include <groundplan/gis/tiled.h>
 
@@ -45,12 +47,15 @@ struct RankWrite {
   bool ok = false;     // every rank wrote and committed
   std::string why;     // otherwise: what failed, on which rank (rank 0 has the whole story)
   std::vector<std::string> dropped;  // rank 0, on failure: the tables this run had made and dropped again
-  double write_s = 0;  // this rank: creating (rank 0) + appending + committing
+  double write_s = 0;  // this rank: creating (rank 0) + appending + committing (+ moving, rank 0)
+  std::string staging_schema;  // rank 0: the schema the tables were made in before the move (pg_staging.h)
+  std::string in_place;        // rank 0: why they were made in the user's schema instead; empty when staged
 };
 
 /// Collective over `ex`: rank 0 creates the tables from `empty_layers` (the layers of `mine` without features,
-/// in the working CRS), every rank appends the layers of `mine` (its share) in a transaction of its own and commits
-/// once every rank has written. Both datasets are taken (closed here). `before_commit` (a test hook) runs after
+/// in the working CRS; in a staging schema where pg_staging.h allows), every rank appends the layers of `mine` (its
+/// share) in a transaction of its own and commits once every rank has written, and rank 0 then moves staged tables
+/// into the user's schema. Both datasets are taken (closed here). `before_commit` (a test hook) runs after
 /// this rank's rows are written, before the outcome is exchanged. A write that fails or throws does not throw:
 /// every rank learns it, every transaction is rolled back (or, where a commit failed, the others' rows stay), and
 /// rank 0 then drops the tables of `setup.tables` that it made in this run (none that existed before); MPI

@@ -3,7 +3,8 @@
 its own final plans into the tables rank 0 made, in a transaction of its own committed only once every rank has
 written. The plans read back (with OGR) must be those of the one-process run (the same exact ring cycles, members,
 problems), GEOS-valid, none split at a tile edge, nothing lost; gp_id and the feature ids (ogc_fid) those a run
-gathering on rank 0 gives. A rank killed before the commit leaves no row of the run.
+gathering on rank 0 gives. The tables are made in a staging schema and reach the public schema only once every
+rank has committed: a rank killed before leaves no table of the run there (and -overwrite leaves the old ones).
 
 The server is Debian's postgresql + postgis, started here on a temporary folder with a local socket only (no TCP)
 and stopped after; as root (CI) it runs as the postgres user. Skipped, with the reason, where the server binaries,
@@ -186,6 +187,9 @@ def test_four_ranks_write_into_postgis(server, city, niedersachsen_and_a_bad_til
         assert [p for p in got[2] if p[2] == "UNREADABLE_FILE"], got[2]
     st = json.loads(stats.read_text())
     assert st["counts"]["ground_plans"] == len(got[0])
+    # made in a staging schema, moved into public once every rank had committed, the staging schema gone
+    assert st["writer"]["staging_schema"].startswith("groundplan_partial_"), st["writer"]
+    assert staging_schemas(server, name) == []
     check_plans(got, st, 4, tiles)  # GEOS-valid, none split, buildings = members + dropped
     # the same numbering as the 4 ranks gathering on rank 0 into a CSV
     gathered = outputs(tmp_path, "gathered", folder, "--tiles", "on", *flags, launcher=mpirun(4))
@@ -201,34 +205,88 @@ def test_four_ranks_write_into_postgis(server, city, niedersachsen_and_a_bad_til
             assert server.psql(name, f"SELECT last_value FROM {table}_ogc_fid_seq") == str(rows), table
 
 
+TABLES = ("ground_plans", "plan_members", "problems")
+
+
+def tables_in(server, name, schema):
+    """The run's tables present in `schema`, comma-separated in name order."""
+    return server.psql(name, "SELECT coalesce(string_agg(tablename, ',' ORDER BY tablename), '') FROM pg_tables "
+                             f"WHERE schemaname = '{schema}' AND tablename IN ('ground_plans', 'plan_members', "
+                             "'problems')")
+
+
+def staging_schemas(server, name):
+    """The staging schemas left in the database (groundplan_partial_*)."""
+    got = server.psql(name, "SELECT string_agg(nspname, ',') FROM pg_namespace WHERE nspname LIKE 'groundplan%'")
+    return got.split(",") if got else []
+
+
+def mpi_into(server, name, conn, folder, fail, *flags):
+    env = gdal_env()
+    env["GROUNDPLAN_MPI_TEST_FAIL"] = fail
+    return subprocess.run([*mpirun(4), "-x", "GROUNDPLAN_MPI_TEST_FAIL", BIN, "-q", "--tiles", "on", "--id-field",
+                           "bid", *flags, "-f", "PostgreSQL", conn, str(folder), *TABLES],
+                          capture_output=True, text=True, env=env, timeout=300)
+
+
 @pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
 @pytest.mark.parametrize("how", ["kill", "throw"])
 def test_a_rank_that_dies_before_the_commit_leaves_no_row(server, city, how):
-    """Rank 2 has written its rows (not committed) and fails. Thrown: every rank learns it and rolls back, and rank 0
-    drops the tables it made in this run (an orderly failure naming rank 2). Killed: mpirun ends every rank, each
-    transaction is rolled back when its connection closes, and the tables rank 0 made stay, without a row (no rank
-    is left to drop them)."""
+    """Rank 2 has written its rows (not committed) and fails. Rank 0 made the tables in a staging schema, and the
+    user's schema gets them only once every rank has committed. Thrown: every rank learns it and rolls back, and rank
+    0 drops the staging schema (an orderly failure naming rank 2). Killed: mpirun ends every rank, each transaction is
+    rolled back when its connection closes; the public schema holds no table of the run, and the staging schema that
+    stays (no rank is left to drop it) says in its comment what it is, and holds no row."""
     folder, _ = city
-    env = gdal_env()
-    env["GROUNDPLAN_MPI_TEST_FAIL"] = f"2:{how}@commit"
     name, conn = server.new_database()
-    p = subprocess.run([*mpirun(4), "-x", "GROUNDPLAN_MPI_TEST_FAIL", BIN, "-q", "--tiles", "on", "--id-field", "bid",
-                        "-f", "PostgreSQL", conn, str(folder), "ground_plans", "plan_members", "problems"],
-                       capture_output=True, text=True, env=env, timeout=300)
+    p = mpi_into(server, name, conn, folder, f"2:{how}@commit")
     assert p.returncode != 0
-    tables = ("ground_plans", "plan_members", "problems")
-    present = server.psql(name, "SELECT string_agg(tablename, ',' ORDER BY tablename) FROM pg_tables WHERE "
-                                "schemaname = 'public' AND tablename IN ('ground_plans', 'plan_members', 'problems')")
+    assert tables_in(server, name, "public") == ""
+    left = staging_schemas(server, name)
     if how == "throw":
         assert "could not write" in p.stderr and "rank 2: GROUNDPLAN_MPI_TEST_FAIL" in p.stderr, p.stderr
         assert "every rank rolled back" in p.stderr and "the tables this run made are dropped" in p.stderr, p.stderr
-        assert present == "", present
+        assert left == [], left
     else:
         assert "rank 2" in p.stderr and "signal 9" in p.stderr, p.stderr
-        # the tables exist (rank 0 made them before anyone wrote) and hold nothing
-        assert present == ",".join(sorted(tables))
-        for table in tables:
-            assert server.psql(name, f"SELECT count(*) FROM {table}") == "0", table
+        assert len(left) == 1 and left[0].startswith("groundplan_partial_"), left
+        assert tables_in(server, name, left[0]) == ",".join(TABLES)
+        for table in TABLES:
+            assert server.psql(name, f"SELECT count(*) FROM {left[0]}.{table}") == "0", table
+        comment = server.psql(name, f"SELECT obj_description('{left[0]}'::regnamespace)")
+        assert "has not finished" in comment and f'DROP SCHEMA "{left[0]}" CASCADE' in comment, comment
+
+
+@pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
+@pytest.mark.parametrize("how", ["kill", "throw", None])
+def test_overwrite_replaces_the_old_tables_only_once_every_rank_has_written(server, city, tmp_path, how):
+    """-overwrite over the tables of an earlier run: a run that fails (an orderly failure, or a rank killed) leaves
+    the old tables as they were, rows and all; one that succeeds replaces them (the plans of a fresh run, no staging
+    schema left, the id sequences past every id)."""
+    folder, _ = city
+    name, conn = server.new_database()
+    stats = tmp_path / "s.json"
+    first = mpi_into(server, name, conn, folder, "", "--stats", str(stats))
+    assert first.returncode == 0, first.stderr
+    assert json.loads(stats.read_text())["writer"]["staging_schema"].startswith("groundplan_partial_")
+    server.psql(name, "UPDATE ground_plans SET building_ids = 'old' WHERE ogc_fid = 1")
+    old = {t: server.psql(name, f"SELECT count(*) FROM {t}") for t in TABLES}
+    assert int(old["ground_plans"]) > COURTYARDS
+    p = mpi_into(server, name, conn, folder, f"1:{how}@commit" if how else "", "-overwrite")
+    if how:
+        assert p.returncode != 0
+        assert server.psql(name, "SELECT building_ids FROM ground_plans WHERE ogc_fid = 1") == "old"
+        assert {t: server.psql(name, f"SELECT count(*) FROM {t}") for t in TABLES} == old
+        assert len(staging_schemas(server, name)) == (1 if how == "kill" else 0)
+    else:
+        assert p.returncode == 0, p.stderr
+        assert server.psql(name, "SELECT building_ids FROM ground_plans WHERE ogc_fid = 1") != "old"
+        assert {t: server.psql(name, f"SELECT count(*) FROM {t}") for t in TABLES} == old
+        assert staging_schemas(server, name) == []
+        rows = old["ground_plans"]
+        assert server.psql(name, "SELECT last_value FROM ground_plans_ogc_fid_seq") == rows
+        assert server.psql(name, "SELECT count(*) FROM pg_indexes WHERE schemaname = 'public' AND "
+                                 "tablename = 'ground_plans' AND indexdef LIKE '%gist%'") == "1"
 
 
 @pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
@@ -246,6 +304,7 @@ def test_a_failed_run_drops_only_the_tables_it_made(server, city):
                        capture_output=True, text=True, env=env, timeout=300)
     assert p.returncode != 0
     assert "the tables this run made are dropped: ground_plans, plan_members" in p.stderr, p.stderr
+    assert staging_schemas(server, name) == []  # problems existed: appended in place, as GDAL's ogr2ogr appends
     present = server.psql(name, "SELECT string_agg(tablename, ',' ORDER BY tablename) FROM pg_tables WHERE "
                                 "schemaname = 'public' AND tablename IN ('ground_plans', 'plan_members', 'problems')")
     assert present == "problems"
