@@ -527,6 +527,7 @@ bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::Til
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     j["mpi"] = {{"ranks", r.ranks.size()}, {"reduce_rounds", t.reduce_rounds}, {"per_rank", per_rank},
+                {"progress_bytes_heard", t.progress_bytes_heard},
                 {"rank0_peak_rss_after_write_bytes", static_cast<std::uint64_t>(u.ru_maxrss) * 1024}};
   }
   j["raster_backend"] = r.raster_backend;

@@ -18,6 +18,7 @@ namespace groundplan::cli {
 namespace {
 
 constexpr int kTag = 15;
+constexpr int kProgressTag = 16;  // tell_progress words: {bytes read, last}
 constexpr std::uint64_t kChunk = std::uint64_t{1} << 30;  // MPI counts are int: large messages go in pieces
 
 void check(int rc, const char* what) {
@@ -148,6 +149,50 @@ std::vector<char> MpiExchange::receive(int from) {
     check(MPI_Recv(bytes.data() + at, part, MPI_BYTE, from, kTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
   }
   return bytes;
+}
+
+void MpiExchange::tell_progress(std::uint64_t bytes_read, bool last) {
+  if (rank_ == 0) return;
+  // Words already delivered free their buffers; a rank sends one a run of tiles, so few are ever in flight.
+  while (!told_.empty()) {
+    int done = 0;
+    check(MPI_Test(&told_.front().second, &done, MPI_STATUS_IGNORE), "MPI_Test");
+    if (!done) break;
+    told_.pop_front();
+  }
+  told_.emplace_back(std::array<std::uint64_t, 2>{bytes_read, last ? 1u : 0u}, MPI_REQUEST_NULL);
+  auto& [word, request] = told_.back();
+  check(MPI_Isend(word.data(), 2, MPI_UINT64_T, 0, kProgressTag, MPI_COMM_WORLD, &request), "MPI_Isend");
+  if (!last) return;
+  // The last word: rank 0 waits for it before the run's next collective, so this does not wait long.
+  for (auto& [w, r] : told_) check(MPI_Wait(&r, MPI_STATUS_IGNORE), "MPI_Wait");
+  told_.clear();
+}
+
+void MpiExchange::heard_progress(bool until_last, const std::function<void(std::uint64_t)>& more) {
+  if (rank_ != 0 || size_ < 2) return;
+  heard_.resize(static_cast<std::size_t>(size_), 0);
+  for (;;) {
+    int waiting = 0;
+    MPI_Status status;
+    if (until_last && last_words_ < size_ - 1) {
+      check(MPI_Probe(MPI_ANY_SOURCE, kProgressTag, MPI_COMM_WORLD, &status), "MPI_Probe");
+      waiting = 1;
+    } else {
+      check(MPI_Iprobe(MPI_ANY_SOURCE, kProgressTag, MPI_COMM_WORLD, &waiting, &status), "MPI_Iprobe");
+    }
+    if (!waiting) return;
+    std::array<std::uint64_t, 2> word{};
+    check(MPI_Recv(word.data(), 2, MPI_UINT64_T, status.MPI_SOURCE, kProgressTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
+          "MPI_Recv");
+    std::uint64_t& was = heard_[static_cast<std::size_t>(status.MPI_SOURCE)];
+    if (word[1]) ++last_words_;
+    if (word[0] > was) {
+      const std::uint64_t n = word[0] - was;
+      was = word[0];
+      more(n);
+    }
+  }
 }
 
 }  // namespace groundplan::cli

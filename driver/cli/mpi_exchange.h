@@ -5,8 +5,14 @@
 // the CLI is the one-process CLI.
 #include <groundplan/gis/tiled.h>
 
+#include <mpi.h>
+
+#include <array>
+#include <deque>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace groundplan::cli {
 
@@ -21,6 +27,9 @@ class MpiExchange final : public gis::TileExchange {
   std::vector<char> allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes = nullptr) override;
   void send(int to, const std::vector<char>& bytes) override;
   std::vector<char> receive(int from) override;
+  /// Progress words: point to point with a tag of their own (kProgressTag), so they never match the run's sends.
+  void tell_progress(std::uint64_t bytes_read, bool last) override;
+  void heard_progress(bool until_last, const std::function<void(std::uint64_t)>& more) override;
   /// Rank 0's `text` on every rank (collective). A step of the CLI's own before the tiled run: unlike allgather,
   /// not counted by GROUNDPLAN_MPI_TEST_FAIL (whose plain form fails at the run's second allgather).
   std::string broadcast(const std::string& text);
@@ -39,6 +48,11 @@ class MpiExchange final : public gis::TileExchange {
  private:
   int rank_ = 0, size_ = 1;
   int calls_ = 0;  // for GROUNDPLAN_MPI_TEST_FAIL
+  // tell_progress: words sent and not known to be delivered yet (a word's buffer lives until then)
+  std::deque<std::pair<std::array<std::uint64_t, 2>, MPI_Request>> told_;
+  // heard_progress (rank 0): each rank's latest count, and how many last words have come
+  std::vector<std::uint64_t> heard_;
+  int last_words_ = 0;
   void test_failure(const std::string& point);
 };
 

@@ -97,6 +97,22 @@ def test_generated_city_over_ranks(tmp_path, city, city_one, ranks):
     assert t["seam_plans"] > 0
 
 
+def test_progress_over_ranks_counts_every_ranks_bytes(tmp_path, city):
+    """-progress under mpirun: rank 0 shows it, and its reading part counts the bytes every other rank says it read
+    (MPI words of their own, TileExchange::tell_progress): --stats "mpi" progress_bytes_heard is exactly the other
+    ranks' bytes. The run ends as a plain one does."""
+    folder, _ = city
+    stats = tmp_path / "s.json"
+    p = run([*mpirun(4), BIN, "-progress", "--threads", "1", "--stats", stats, "--tiles", "on", "--id-field", "bid",
+             "-f", "GPKG", tmp_path / "p.gpkg", folder])
+    # GDAL's progress from rank 0 alone: the run's, then the GeoPackage write's
+    assert p.stdout.startswith("0...10...20...") and p.stdout.count("100 - done") == 2, p.stdout
+    st = json.loads(stats.read_text())["mpi"]
+    others = sum(r["bytes"] for r in st["per_rank"][1:])
+    assert others > 0
+    assert st["progress_bytes_heard"] == others
+
+
 def test_mpirun_without_tiles_on_takes_the_tiled_run(tmp_path, city, city_one):
     """Under mpirun with several ranks --tiles auto means the ranks share the tiled run."""
     folder, tiles = city

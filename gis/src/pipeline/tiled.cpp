@@ -310,7 +310,8 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
   context.working_definition = options.t_srs;
   std::size_t files_failed = 0;
   std::string first_failure;
-  detail::ByteProgress bytes(ranks == 1 ? progress.sub(0, 0.9) : Progress{}, acc.reading.bytes);
+  // Over ranks, rank 0's count also takes in the bytes the other ranks say they read (TileExchange::tell_progress).
+  detail::ByteProgress bytes(progress.sub(0, 0.9), acc.reading.bytes);
   progress.report(0, "reading tiles");
   std::vector<detail::Box> extents;  // this rank's tiles, in file order
   std::size_t tile_first = 0;        // the global index of this rank's first tile
@@ -388,6 +389,11 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     if (me != 0) fi = tile_first;
   }
   const std::size_t tile_end = bounds[static_cast<std::size_t>(me) + 1];
+  std::uint64_t share_read = 0;  // bytes of this rank's run of tiles read so far (told to rank 0)
+  const std::function<void(std::uint64_t)> heard = [&](std::uint64_t n) {  // rank 0: bytes other ranks read
+    ts.progress_bytes_heard += n;
+    bytes.add(n);
+  };
   while (fi < tile_end) {
     const std::size_t n = std::min(threads, tile_end - fi);
     std::uint64_t shared = 0;
@@ -401,7 +407,13 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     for (std::size_t k = 0; k < n; ++k) map_tile(std::move(reads[k]), fi + k);
     ts.tiles_in_flight = std::max(ts.tiles_in_flight, n);
     fi += n;
+    share_read += shared;
+    if (ranks > 1 && me != 0) ex.tell_progress(share_read, fi == tile_end);
+    if (ranks > 1 && me == 0) ex.heard_progress(false, heard);
   }
+  // Every rank's word that it has read all of its tiles (rank 0 shows their bytes while it waits for them).
+  if (ranks > 1 && me != 0 && tile_first == tile_end) ex.tell_progress(0, true);
+  if (ranks > 1 && me == 0) ex.heard_progress(true, heard);
   out->spill.flush();
   ts.spill_bytes = out->spill.size();
   share.footprints = static_cast<std::size_t>(next_local);
@@ -561,6 +573,7 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     TileStats tsum;
     tsum.tiles = ts.tiles;
     tsum.reduce_rounds = ts.reduce_rounds;
+    tsum.progress_bytes_heard = ts.progress_bytes_heard;
     for (int r = 0; r < ranks; ++r) {
       const std::vector<char> bytes = r == 0 ? p.bytes : ex.receive(r);
       detail::Unpacker u(bytes.data(), bytes.size());

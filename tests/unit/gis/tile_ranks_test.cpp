@@ -16,6 +16,7 @@
 
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <random>
@@ -170,6 +171,28 @@ class ThreadRanks {
       box.pop_front();
       return b;
     }
+    void tell_progress(std::uint64_t bytes_read, bool last) override {
+      std::lock_guard lock(all_.m_);
+      all_.words_.push_back({me_, bytes_read, last});
+      all_.cv_.notify_all();
+    }
+    void heard_progress(bool until_last, const std::function<void(std::uint64_t)>& more) override {
+      std::unique_lock lock(all_.m_);
+      all_.heard_.resize(static_cast<std::size_t>(all_.n_), 0);
+      for (;;) {
+        if (until_last) all_.cv_.wait(lock, [&] { return !all_.words_.empty() || all_.last_words_ == all_.n_ - 1; });
+        if (all_.words_.empty()) return;
+        const Word w = all_.words_.front();
+        all_.words_.pop_front();
+        all_.last_words_ += w.last ? 1 : 0;
+        std::uint64_t& was = all_.heard_[static_cast<std::size_t>(w.from)];
+        const std::uint64_t n = w.bytes > was ? w.bytes - was : 0;
+        was = std::max(was, w.bytes);
+        lock.unlock();
+        if (n) more(n);
+        lock.lock();
+      }
+    }
 
    private:
     ThreadRanks& all_;
@@ -186,6 +209,14 @@ class ThreadRanks {
   std::vector<char> gathered_;
   std::vector<std::uint64_t> sizes_;
   std::map<std::pair<int, int>, std::deque<std::vector<char>>> mail_;
+  struct Word {
+    int from;
+    std::uint64_t bytes;
+    bool last;
+  };
+  std::deque<Word> words_;          // tell_progress words not heard yet
+  std::vector<std::uint64_t> heard_;  // each rank's count as rank 0 heard it
+  int last_words_ = 0;
 };
 
 /// Plans as comparable rows: members (global indices) and member ids, area, the outer ring's vertex set.
@@ -239,7 +270,8 @@ std::string city(const test::TempDir& dir) {
 }
 
 /// Runs `options` over n ranks played by threads; every rank's result, in rank order.
-std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOptions& options, int n, FinalPlans where) {
+std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOptions& options, int n, FinalPlans where,
+                                                            const Progress& rank_0_progress = {}) {
   ThreadRanks all(n);
   std::vector<std::unique_ptr<TiledResult>> results(static_cast<std::size_t>(n));
   std::vector<std::string> errors(static_cast<std::size_t>(n));
@@ -248,7 +280,8 @@ std::vector<std::unique_ptr<TiledResult>> over_thread_ranks(const PipelineOption
     threads.emplace_back([&, r] {
       ThreadRanks::Rank me(all, r);
       try {
-        results[static_cast<std::size_t>(r)] = run_pipeline_tiled(options, me, {}, where);
+        results[static_cast<std::size_t>(r)] = run_pipeline_tiled(options, me, r == 0 ? rank_0_progress : Progress{},
+                                                                  where);
       } catch (const std::exception& e) {
         errors[static_cast<std::size_t>(r)] = e.what();
       }
@@ -326,6 +359,38 @@ TEST(TiledRunOverRanks, KeptPlansAreNumberedAsRankZeroGathersThem) {
     // rank 0 still has the counts of all ranks
     EXPECT_EQ(kept[0]->tiles.final_plans + kept[0]->tiles.reduced_plans, g.plan_count());
     EXPECT_EQ(kept[0]->footprints, g.footprints);
+  }
+}
+
+// -progress over ranks: only rank 0 shows it, and its reading part (0 to 0.9) counts every rank's bytes, which
+// each rank tells it as it reads (TileExchange::tell_progress). Counting its own alone, it would stop near its own
+// share (about 1/n of the bytes) and jump to 0.9 at "seams".
+TEST(TiledRunOverRanks, RankZeroShowsTheBytesEveryRankRead) {
+  GDALAllRegister();
+  const test::TempDir dir("groundplan_tile_ranks_progress");
+  const PipelineOptions options = city_options(dir);
+  for (int n : {1, 2, 4, 9}) {
+    std::mutex m;
+    std::vector<std::pair<double, std::string>> seen;
+    const Progress progress([&](double f, const char* message) {
+      std::lock_guard lock(m);
+      seen.emplace_back(f, message ? message : "");
+      return true;
+    });
+    const auto results = over_thread_ranks(options, n, FinalPlans::to_rank_0, progress);
+    ASSERT_TRUE(results[0]) << n << " ranks";
+    double read = -1;
+    bool seams = false;
+    for (const auto& [f, message] : seen) {
+      if (message == "seams") {
+        seams = true;
+        break;
+      }
+      EXPECT_GE(f, read) << n << " ranks: progress went back";
+      read = f;
+    }
+    EXPECT_TRUE(seams) << n << " ranks";
+    EXPECT_NEAR(read, 0.9, 1e-12) << n << " ranks: the reading part ended short of every rank's bytes";
   }
 }
 

@@ -8,6 +8,7 @@
 #include <groundplan/gis/pipeline.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +36,19 @@ class TileExchange {
   /// Point to point, blocking; messages from one rank to another arrive in the order sent.
   virtual void send(int to, const std::vector<char>& bytes) = 0;
   virtual std::vector<char> receive(int from) = 0;
+  /// Progress over ranks (not collective; the calling thread is the one making the collective calls). A rank
+  /// r > 0 tells rank 0 how many bytes of its tiles it has read so far, `last` once it has read them all; it does
+  /// not wait for rank 0 to hear it. By default (one process) nothing is said.
+  virtual void tell_progress(std::uint64_t bytes_read, bool last) {
+    (void)bytes_read;
+    (void)last;
+  }
+  /// Rank 0: gives `more` the bytes the other ranks have said they read since the last word it heard, word by word
+  /// as they come (those arrived so far; with `until_last`, until every other rank's last word has come).
+  virtual void heard_progress(bool until_last, const std::function<void(std::uint64_t)>& more) {
+    (void)until_last;
+    (void)more;
+  }
 };
 
 /// The exchange of a run in one process: rank 0 of 1.
@@ -71,6 +85,7 @@ struct TileStats {
   std::uint64_t spill_bytes = 0;        // the map's temporary file (plans + their member footprints)
   double map_s = 0, reduce_s = 0;       // wall times: read + tile unions + spill; seams' union
   std::size_t reduce_rounds = 0;        // the reduce tree's rounds after each rank's own: ceil(log2(ranks))
+  std::uint64_t progress_bytes_heard = 0;  // rank 0: bytes the other ranks said they read (tell_progress)
 };
 
 /// The result of a tiled run. The plans live in a temporary file (deleted when this is destroyed) and
