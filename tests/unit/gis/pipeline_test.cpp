@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -88,6 +89,41 @@ TEST(Pipeline, FolderOfTilesIsOneInput) {
   EXPECT_EQ(r.buildings_read, 408u + 259u - 0u) << "408 Buildings + 259 BuildingParts (SOURCE.txt)";
   const gis::GeosComparison cmp = gis::compare_with_geos(r.footprints, r.plans);
   EXPECT_TRUE(cmp.matches(1e-9)) << cmp.summary();
+}
+
+// A folder: the first file is read alone (it fixes the working CRS), the others side by side, and their footprints
+// are moved into the result side by side (pipeline.cpp append_footprints). They must come out file by file, in
+// the folder's order, each file's as reading that file alone gives them.
+TEST(Pipeline, FolderFootprintsComeOutFileByFileAsEachFileAlone) {
+  namespace fs = std::filesystem;
+  const fs::path folder = test::shared_data("citygml1-niedersachsen-lod1-4tiles");
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(folder))
+    if (e.path().extension() == ".gml") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 4u);
+  std::vector<Footprint> want;
+  for (const std::string& f : files) {
+    gis::PipelineOptions one;
+    one.inputs = {f};
+    one.threads = 1;
+    gis::PipelineResult r = gis::run_pipeline(one);
+    ASSERT_FALSE(r.footprints.empty()) << f;
+    for (Footprint& fp : r.footprints) want.push_back(std::move(fp));
+  }
+  for (const int threads : {1, 3}) {
+    gis::PipelineOptions options;
+    options.inputs = {folder.string()};
+    options.threads = threads;
+    const gis::PipelineResult r = gis::run_pipeline(options);
+    ASSERT_EQ(r.footprints.size(), want.size()) << threads << " threads";
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      const Footprint &got = r.footprints[i], &w = want[i];
+      ASSERT_EQ(got.source_file + " " + got.source_id, w.source_file + " " + w.source_id) << i << ", " << threads << " threads";
+      ASSERT_EQ(got.polygons.size(), w.polygons.size()) << w.source_id;
+      for (std::size_t k = 0; k < w.polygons.size(); ++k) ASSERT_EQ(got.polygons[k].outer, w.polygons[k].outer) << w.source_id;
+    }
+  }
 }
 
 TEST(Pipeline, CancelStopsTheWork) {
