@@ -156,6 +156,10 @@ struct WorkingFrame::Impl {
                                                    : proj_clone(ctx, src_h.get()));
     PjPtr dst(proj_normalize_for_visualization(ctx, t.working.get()));
     if (!src_in || !dst) throw Error(where() + "PROJ could not normalise the axis order of " + source.text);
+    // The target is the source CRS itself (a folder's later tiles, in the CRS the first one fixed): nothing to
+    // transform, as for the file that fixed it. PROJ's operation between the two would give the same numbers
+    // (a no-op), through proj_trans for every vertex: ~0.3 s of CPU on the 1.5 GB city as 16 tiles.
+    if (proj_is_equivalent_to(src_in.get(), dst.get(), PJ_COMP_STRICT)) return;
     t.op.reset(proj_create_crs_to_crs_from_pj(ctx, src_in.get(), dst.get(), nullptr, nullptr));
     if (!t.op)
       throw InputError(where() + "PROJ finds no transformation from " + source.text + " to " + t.crs.name +
@@ -309,6 +313,7 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
                             "\" is not a projected CRS in metres that PROJ knows (ground plans need a metric frame)");
     m.fill_crs(base, t.definition);
     m.make_op(base);
+    m.base_identity = !base.op && !m.swap_in;
     m.base_decided = true;
   } else if (m.src_known && m.src_metric_projected) {
     base.working.reset(proj_clone(m.ctx, m.src_h.get()));

@@ -66,6 +66,30 @@ TEST(WorkingFrame, ProjectedMetricSourceIsTheWorkingCrs) {
   EXPECT_EQ(x, 457842);
 }
 
+// A folder's later tiles get the working CRS the first one fixed as their target: where that is their own CRS
+// (here the horizontal part of a compound srsName), nothing is transformed, exactly as for the first tile; another
+// projected CRS is transformed through PROJ.
+TEST(WorkingFrame, TargetThatIsTheSourceCrsTransformsNothing) {
+  for (const char* source : {"EPSG:25832", "urn:ogc:def:crs:EPSG::25832", "urn:ogc:def:crs,crs:EPSG::25832,crs:EPSG::7837"}) {
+    CrsOptions o;
+    o.target_srs = "EPSG:25832";
+    WorkingFrame f(source, o);
+    EXPECT_TRUE(f.identity()) << source;
+    EXPECT_EQ(f.working_crs().epsg, 25832) << source;
+    double x = 457842.123456789, y = 5439083.987654321;
+    EXPECT_TRUE(f.transform_point(x, y));
+    EXPECT_EQ(x, 457842.123456789) << source;
+    EXPECT_EQ(y, 5439083.987654321) << source;
+  }
+  CrsOptions o;
+  o.target_srs = "EPSG:25832";
+  WorkingFrame other("EPSG:25833", o);
+  EXPECT_FALSE(other.identity());
+  double x = 457842, y = 5439083;
+  EXPECT_TRUE(other.transform_point(x, y));
+  EXPECT_GT(std::fabs(x - 457842), 1000.0);  // zone 33 to zone 32: hundreds of kilometres
+}
+
 TEST(WorkingFrame, FzkHausFootprintLandsInUtm32) {
   std::vector<Mesh> meshes;
   std::vector<Problem> problems;
