@@ -604,6 +604,9 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   const groundplan::cli::RankWrite w = groundplan::cli::write_from_every_rank(
       ranks, setup, mine, empty, [&ranks] { ranks.test_point("commit"); });
   if (!root) return w.ok ? 0 : 1;
+  if (!ogr.quiet)
+    for (const std::string& s : w.left_over)
+      std::fprintf(stderr, "groundplan: warning: the database holds the staging schema of another run: %s\n", s.c_str());
   if (!setup.create) {
     write_tiled_stats(stats_path, r, 0, 0, 0, nullptr, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0);
     return 1;

@@ -126,6 +126,9 @@ std::optional<PgStaging> make_staging_schema(const std::string& dst, const CPLSt
   PgStaging s;
   s.dst = dst;
   s.target = target->front();
+  if (const auto found = c.column("SELECT nspname || ': ' || coalesce(obj_description(oid, 'pg_namespace'), '') "
+                                  "FROM pg_namespace WHERE nspname LIKE 'groundplan\\_partial\\_%' ORDER BY 1"))
+    s.found = *found;
   const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
   s.schema = "groundplan_partial_" + std::to_string(::getpid()) + "_" + std::to_string(ticks % 1000000007);
   char host[256] = {};

@@ -29,6 +29,9 @@ struct PgStaging {
   std::string dst;     // the user's datasource
   std::string schema;  // the staging schema
   std::string target;  // the schema the tables go to (the connection's current one)
+  /// Staging schemas already there when this one was made (runs that were killed, or that run now), each with
+  /// its comment: "name: comment".
+  std::vector<std::string> found;
   /// The datasource with the staging schema as its active schema: what rank 0 makes the tables in and every rank
   /// appends to (GDAL's layer names then resolve there, so `-overwrite` does not reach the user's tables early).
   std::string staged_dst() const;

@@ -198,6 +198,7 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     if (w.in_place.empty()) staging = make_staging_schema(setup.dst, doo, &no_schema);
     if (w.in_place.empty() && !staging) w.in_place = no_schema;  // e.g. no CREATE right on the database
     if (staging) w.staging_schema = staging->schema;
+    if (staging) w.left_over = staging->found;
   }
   if (ex.rank() == 0)
     created = !setup.create ? std::string("nothing to write")
@@ -275,7 +276,8 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     return w;
   }
   if (!not_committed.empty()) {
-    w.why = not_committed + " (the other ranks' rows are committed: the tables are incomplete)";
+    w.why = not_committed + (staging ? " (the other ranks' rows were committed in the staging schema only)"
+                                      : " (the other ranks' rows are committed: the tables are incomplete)");
     if (ex.rank() == 0) w.why += drop_made();
     return w;
   }

@@ -255,6 +255,15 @@ def test_a_rank_that_dies_before_the_commit_leaves_no_row(server, city, how):
             assert server.psql(name, f"SELECT count(*) FROM {left[0]}.{table}") == "0", table
         comment = server.psql(name, f"SELECT obj_description('{left[0]}'::regnamespace)")
         assert "has not finished" in comment and f'DROP SCHEMA "{left[0]}" CASCADE' in comment, comment
+        # the next run into that database says so (and writes its own tables as usual)
+        env = gdal_env()
+        p = subprocess.run([*mpirun(4), BIN, "--tiles", "on", "--id-field", "bid", "-f", "PostgreSQL", conn,
+                            str(folder), *TABLES], capture_output=True, text=True, env=env, timeout=300)
+        assert p.returncode == 0, p.stderr
+        assert f"the database holds the staging schema of another run: {left[0]}: groundplan: the tables" in \
+            p.stderr, p.stderr
+        assert tables_in(server, name, "public") == ",".join(TABLES)
+        assert staging_schemas(server, name) == left
 
 
 @pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
