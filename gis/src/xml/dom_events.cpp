@@ -4,6 +4,7 @@
 
 #include <pugixml.hpp>
 
+#include <array>
 #include <cstdint>
 #include <cstring>
 #if defined(__SSE2__)
@@ -90,20 +91,46 @@ struct Binding {
 /// An element or attribute name of ASCII name characters only, not starting with a digit, '-' or '.':
 /// the names expat and pugixml both read alike (pugixml takes any byte >= 0x80 as a name character, expat
 /// only those Unicode allows).
-bool plain_name(const char* name) {
-  const auto c0 = static_cast<unsigned char>(*name);
-  if (!c0 || (c0 >= '0' && c0 <= '9') || c0 == '-' || c0 == '.') return false;
-  for (; *name; ++name) {
-    const auto c = static_cast<unsigned char>(*name);
-    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
-          c == '.' || c == ':'))
-      return false;
+/// Which bytes plain_name takes: 1 anywhere in a name, 2 also first.
+constexpr std::array<std::uint8_t, 256> kNameBytes = [] {
+  std::array<std::uint8_t, 256> t{};
+  for (int c = 0; c < 256; ++c) {
+    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == ':';
+    const bool other = (c >= '0' && c <= '9') || c == '-' || c == '.';
+    t[static_cast<std::size_t>(c)] = letter ? 3 : other ? 1 : 0;
   }
+  return t;
+}();
+
+bool plain_name(const char* name) {
+  // A table, not a chain of comparisons: the checks call this for every element and attribute name.
+  const auto* p = reinterpret_cast<const unsigned char*>(name);
+  if (!(kNameBytes[*p] & 2)) return false;  // also the empty name (byte 0)
+  for (++p; *p; ++p)
+    if (!kNameBytes[*p]) return false;
   return true;
 }
 
 /// "p:local" -> where the colon is, or nullptr.
 const char* colon_of(const char* name);
+
+/// In one pass, what check_element asks of an element or attribute name: a plain name whose colon, if any, is
+/// the only one and splits it into a non-empty prefix and a local part that is a plain name itself. `colon`:
+/// where the colon is, or nullptr.
+bool plain_qualified_name(const char* name, const char*& colon) {
+  const auto* p = reinterpret_cast<const unsigned char*>(name);
+  colon = nullptr;
+  if (!(kNameBytes[*p] & 2) || *p == ':') return false;  // also the empty name; ":x" has an empty prefix
+  for (++p; *p; ++p) {
+    if (*p != ':') {
+      if (!kNameBytes[*p]) return false;
+      continue;
+    }
+    if (colon || !(kNameBytes[p[1]] & 2) || p[1] == ':') return false;  // a second colon, or a bad local start
+    colon = reinterpret_cast<const char*>(p);
+  }
+  return true;
+}
 
 /// Why expat would refuse a comment or a processing instruction that pugixml read: "--" inside a comment
 /// or "-" at its end; a PI target named xml in any case, or one that is not a plain name.
@@ -309,27 +336,28 @@ struct DomEvents::Impl {
     return false;
   }
   std::string check_element(pugi::xml_node n) {
-    const char* local;
-    bool prefixed;
     const char* qname = n.name();
-    if (!plain_name(qname)) return "the element name \"" + std::string(qname) + "\"";
-    const Binding* b = resolve(qname, false, local, prefixed);
-    if (prefixed && (local == qname + 1 || !plain_name(local) || colon_of(local)))
-      return "the element name \"" + std::string(qname) + "\"";
-    if (prefixed && !b) return "the unbound prefix of \"" + std::string(qname) + "\"";
-    if (holds_elements(n) && text_element(prefixed ? local : qname))
+    const char* colon;
+    if (!plain_qualified_name(qname, colon)) return "the element name \"" + std::string(qname) + "\"";
+    const bool prefixed = colon != nullptr;
+    const char* local = prefixed ? colon + 1 : qname;
+    if (prefixed && !find(std::string_view(qname, static_cast<std::size_t>(colon - qname))))
+      return "the unbound prefix of \"" + std::string(qname) + "\"";
+    if (text_element(prefixed ? local : qname) && holds_elements(n))
       return "the text element \"" + std::string(qname) + "\" holding elements";
     std::size_t count = 0;
     for (pugi::xml_attribute a = n.first_attribute(); a; a = a.next_attribute()) {
       if (++count > kMaxAttributes) return "an element with more than " + std::to_string(kMaxAttributes) + " attributes";
       const char* an = a.name();
-      if (!plain_name(an)) return "the attribute name \"" + std::string(an) + "\"";
+      const char* acolon;
+      const bool shaped = plain_qualified_name(an, acolon);
+      if (!shaped && !plain_name(an)) return "the attribute name \"" + std::string(an) + "\"";
       if (std::strchr(a.value(), '<')) return "a '<' in the value of \"" + std::string(an) + "\"";  // or &lt;: expat's
       if (is_declaration(an)) continue;
-      const char* al;
-      bool ap;
-      const Binding* ab = resolve(an, true, al, ap);
-      if (ap && (al == an + 1 || !plain_name(al) || colon_of(al))) return "the attribute name \"" + std::string(an) + "\"";
+      if (!shaped) return "the attribute name \"" + std::string(an) + "\"";
+      const bool ap = acolon != nullptr;
+      const char* al = ap ? acolon + 1 : an;
+      const Binding* ab = ap ? find(std::string_view(an, static_cast<std::size_t>(acolon - an))) : nullptr;
       if (ap && !ab) return "the unbound prefix of \"" + std::string(an) + "\"";
       // duplicates, by (namespace, local name) as expat compares them
       const std::string_view uri = ap ? ab->uri : std::string_view();
