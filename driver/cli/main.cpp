@@ -607,6 +607,7 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   if (!ogr.quiet)
     for (const std::string& s : w.left_over)
       std::fprintf(stderr, "groundplan: warning: the database holds the staging schema of another run: %s\n", s.c_str());
+  for (const std::string& s : w.warnings) std::fprintf(stderr, "groundplan: warning: %s\n", s.c_str());
   if (!setup.create) {
     write_tiled_stats(stats_path, r, 0, 0, 0, nullptr, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0);
     return 1;

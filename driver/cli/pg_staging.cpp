@@ -177,6 +177,36 @@ std::string move_staged_tables(const PgStaging& s, const CPLStringList& open_opt
   return {};
 }
 
+std::string advance_id_sequences(const std::string& dst, const CPLStringList& open_options,
+                                 const std::vector<std::string>& tables, const std::string& schema) {
+  Connection c(dst, open_options);
+  if (!c.error().empty()) return c.error();
+  GDALDataset* ds = GDALDataset::FromHandle(c.handle());
+  for (const std::string& t : tables) {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    OGRLayer* layer = ds->GetLayerByName(t.c_str());
+    CPLPopErrorHandler();
+    if (!layer) continue;
+    const std::string fid = layer->GetFIDColumn();
+    if (fid.empty()) continue;
+    // GDAL names a table outside the current schema "schema.table".
+    std::string name = layer->GetName(), in = schema;
+    if (in.empty()) {
+      const std::size_t dot = name.find('.');
+      if (dot != std::string::npos) {
+        in = name.substr(0, dot);
+        name = name.substr(dot + 1);
+      }
+    }
+    const std::string table = (in.empty() ? std::string() : quoted_identifier(in) + ".") + quoted_identifier(name);
+    // setval is strict: no sequence (an id column that is not serial) or no row (max NULL) sets nothing.
+    const std::string why = c.exec("SELECT setval(pg_get_serial_sequence(" + quoted_literal(table) + ", " +
+                                   quoted_literal(fid) + "), max(" + quoted_identifier(fid) + ")) FROM " + table);
+    if (!why.empty()) return why;
+  }
+  return {};
+}
+
 std::string drop_staging_schema(const PgStaging& s, const CPLStringList& open_options) {
   Connection c(s.dst, open_options);
   if (!c.error().empty()) return c.error();

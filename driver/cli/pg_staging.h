@@ -46,6 +46,13 @@ std::optional<PgStaging> make_staging_schema(const std::string& dst, const CPLSt
 /// CASCADE). Empty, or why not (the transaction is then rolled back: the target schema is as it was).
 std::string move_staged_tables(const PgStaging& s, const CPLStringList& open_options, bool replace);
 
+/// Sets the id sequence of each of `tables` (by GDAL layer name in `dst`; in `schema` where it is not empty) past
+/// its largest FID, once every rank has committed. Each rank's GDAL sets it when it closes the datasource, but
+/// from the largest id that rank saw: a rank whose statement ran before another's commit could leave the sequence
+/// behind the other's rows, so a later plain append would collide. Empty, or why not.
+std::string advance_id_sequences(const std::string& dst, const CPLStringList& open_options,
+                                 const std::vector<std::string>& tables, const std::string& schema);
+
 /// Drops the staging schema and what is in it; empty, or why not.
 std::string drop_staging_schema(const PgStaging& s, const CPLStringList& open_options);
 

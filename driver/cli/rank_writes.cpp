@@ -281,8 +281,20 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     if (ex.rank() == 0) w.why += drop_made();
     return w;
   }
-  // 4. Rank 0 moves the staged tables into the user's schema, in one transaction (replacing the old ones under
-  // -overwrite): only now does the user's schema hold anything of the run.
+  // 4. Every rank has closed its connection (before the last exchange): rank 0 sets the id sequences past every
+  // rank's rows, then moves the staged tables into the user's schema, in one transaction (replacing the old ones
+  // under -overwrite): only now does the user's schema hold anything of the run.
+  if (ex.rank() == 0) {
+    const std::string why = staging ? advance_id_sequences(staging->staged_dst(), doo, setup.tables, staging->schema)
+                                    : advance_id_sequences(setup.dst, doo, setup.tables, "");
+    if (!why.empty() && !staging)
+      w.warnings.push_back("the rows are committed, but the id sequences may be behind them: " + why);
+    if (!why.empty() && staging) {
+      w.write_s = seconds_since(t0);
+      w.why = "cannot set the id sequences in the staging schema " + staging->schema + ": " + why + drop_made();
+      return w;
+    }
+  }
   if (ex.rank() == 0 && staging) {
     const std::string why = move_staged_tables(*staging, doo, overwrite);
     w.write_s = seconds_since(t0);

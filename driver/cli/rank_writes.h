@@ -51,6 +51,7 @@ struct RankWrite {
   std::string staging_schema;  // rank 0: the schema the tables were made in before the move (pg_staging.h)
   std::string in_place;        // rank 0: why they were made in the user's schema instead; empty when staged
   std::vector<std::string> left_over;  // rank 0: staging schemas of earlier runs found in the database
+  std::vector<std::string> warnings;   // rank 0: what went wrong after the rows were committed in place
 };
 
 /// Collective over `ex`: rank 0 creates the tables from `empty_layers` (the layers of `mine` without features,
