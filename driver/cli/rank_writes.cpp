@@ -155,12 +155,12 @@ bool written_by_every_rank(const std::string& format, const std::string& dst) {
   return dst.rfind("PG:", 0) == 0 || dst.rfind("pg:", 0) == 0;
 }
 
-std::vector<std::string> append_options(const std::vector<std::string>& options) {
+std::vector<std::string> append_options(const std::vector<std::string>& options, bool own_ids) {
   static const std::set<std::string> drop_with_value = {"-f", "-of", "-lco", "-dsco", "-gt"};
   static const std::set<std::string> drop = {"-overwrite", "-append", "-update", "-ds_transaction",
                                              "-lyr_transaction", "-preserve_fid"};
   std::vector<std::string> out;
-  bool preserve = true;
+  bool preserve = own_ids;
   for (std::size_t i = 0; i < options.size(); ++i) {
     const std::string& o = options[i];
     if (drop_with_value.count(o)) {
@@ -225,8 +225,11 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     w.write_s = seconds_since(t0);
     return w;
   }
-  // Where every rank writes: the staging schema, or the user's.
+  // Where every rank writes: the staging schema, or the user's; and whether a table of the run was there before
+  // (its rows' ids could be repeated: the database numbers the new rows instead of gp_id).
   const std::string write_dst = gather_text(ex, ex.rank() == 0 && staging ? staging->staged_dst() : "").at(0);
+  const bool tables_existed = !staging && before && !before->empty();
+  const bool own_ids = gather_text(ex, ex.rank() == 0 && tables_existed ? "existed" : "").at(0).empty();
 
   // 2. Every rank adds its share in one transaction of its own, not committed yet.
   std::string wrote;
@@ -245,7 +248,7 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   } else {
     in_transaction = true;
     HeldTransaction held(GDALDataset::FromHandle(dst));
-    wrote = translate(into, GDALDataset::ToHandle(&held), mine, append_options(setup.options));
+    wrote = translate(into, GDALDataset::ToHandle(&held), mine, append_options(setup.options, own_ids));
   }
   GDALClose(GDALDataset::ToHandle(mine));
   // A rank that throws here (a fault, or the test hook) is a rank that failed to write: every rank rolls back.

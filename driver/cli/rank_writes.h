@@ -27,8 +27,10 @@ bool written_by_every_rank(const std::string& format, const std::string& dst);
 /// The user's ogr2ogr options for a rank's append into tables rank 0 has made: what only creating means (-f, -lco,
 /// -dsco, -overwrite) and the user's transaction settings (-gt, -ds_transaction, -lyr_transaction) are left out;
 /// -append, "-gt unlimited" (one transaction: the rank's own, see rank_writes.cpp) and -preserve_fid (feature ids as in the one
-/// dataset: ogc_fid = gp_id) are added; -preserve_fid not where -unsetFid or -explodecollections asks otherwise.
-std::vector<std::string> append_options(const std::vector<std::string>& options);
+/// dataset: ogc_fid = gp_id) are added; -preserve_fid not where -unsetFid or -explodecollections asks otherwise, nor
+/// without `own_ids` (a table that existed before the run may hold rows whose ids these would repeat: the database's
+/// sequence numbers the new rows then, as GDAL's ogr2ogr -append does in one process).
+std::vector<std::string> append_options(const std::vector<std::string>& options, bool own_ids = true);
 
 /// Every rank's `text`, in rank order (an allgather; also used by gpkg_rank_slices.cpp).
 std::vector<std::string> gather_text(gis::TileExchange& ex, const std::string& text);

@@ -318,3 +318,23 @@ def test_a_failed_run_drops_only_the_tables_it_made(server, city):
                                 "schemaname = 'public' AND tablename IN ('ground_plans', 'plan_members', 'problems')")
     assert present == "problems"
     assert server.psql(name, "SELECT note FROM problems") == "kept"
+
+
+@pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
+def test_append_over_ranks_to_tables_with_rows(server, city):
+    """-append into the tables of an earlier run (written in place): the new rows' ids come from the tables'
+    sequences, as GDAL's ogr2ogr -append numbers them in one process, not from gp_id (which the earlier rows hold
+    already); every row kept, no id twice, the sequences past every id."""
+    folder, _ = city
+    name, conn = server.new_database()
+    first = mpi_into(server, name, conn, folder, "")
+    assert first.returncode == 0, first.stderr
+    rows = {t: int(server.psql(name, f"SELECT count(*) FROM {t}")) for t in TABLES}
+    assert rows["ground_plans"] > COURTYARDS
+    p = mpi_into(server, name, conn, folder, "", "-append")
+    assert p.returncode == 0, p.stderr
+    for t in ("ground_plans", "plan_members"):
+        n = 2 * rows[t]
+        assert server.psql(name, f"SELECT count(*), count(DISTINCT ogc_fid), max(ogc_fid) FROM {t}") == f"{n}|{n}|{n}"
+        assert server.psql(name, f"SELECT last_value FROM {t}_ogc_fid_seq") == str(n), t
+    assert staging_schemas(server, name) == []
