@@ -197,8 +197,10 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     std::string no_schema;
     if (w.in_place.empty()) staging = make_staging_schema(setup.dst, doo, &no_schema);
     if (w.in_place.empty() && !staging) w.in_place = no_schema;  // e.g. no CREATE right on the database
-    if (staging) w.staging_schema = staging->schema;
-    if (staging) w.left_over = staging->found;
+    if (staging) {
+      w.staging_schema = staging->schema;
+      w.left_over = staging->found;
+    }
   }
   if (ex.rank() == 0)
     created = !setup.create ? std::string("nothing to write")
@@ -225,11 +227,15 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
     w.write_s = seconds_since(t0);
     return w;
   }
-  // Where every rank writes: the staging schema, or the user's; and whether a table of the run was there before
-  // (its rows' ids could be repeated: the database numbers the new rows instead of gp_id).
-  const std::string write_dst = gather_text(ex, ex.rank() == 0 && staging ? staging->staged_dst() : "").at(0);
-  const bool tables_existed = !staging && before && !before->empty();
-  const bool own_ids = gather_text(ex, ex.rank() == 0 && tables_existed ? "existed" : "").at(0).empty();
+  // Rank 0's word to every rank, in one exchange: whether a table of the run was there before (its rows' ids could
+  // be repeated: the database numbers the new rows instead of gp_id), then where to write (the staging schema's
+  // datasource; empty: the user's).
+  std::string word;
+  if (ex.rank() == 0) word = std::string(!staging && before && !before->empty() ? "x" : "-") +
+                             (staging ? staging->staged_dst() : std::string());
+  word = gather_text(ex, word).at(0);
+  const bool own_ids = word.rfind('x', 0) != 0;
+  const std::string write_dst = word.size() > 1 ? word.substr(1) : std::string();
 
   // 2. Every rank adds its share in one transaction of its own, not committed yet.
   std::string wrote;

@@ -343,7 +343,7 @@ struct DomEvents::Impl {
     const char* local = prefixed ? colon + 1 : qname;
     if (prefixed && !find(std::string_view(qname, static_cast<std::size_t>(colon - qname))))
       return "the unbound prefix of \"" + std::string(qname) + "\"";
-    if (text_element(prefixed ? local : qname) && holds_elements(n))
+    if (text_element(local) && holds_elements(n))
       return "the text element \"" + std::string(qname) + "\" holding elements";
     std::size_t count = 0;
     for (pugi::xml_attribute a = n.first_attribute(); a; a = a.next_attribute()) {
