@@ -4,8 +4,7 @@
 //   - always: every footprint a member of a plan or named by a union-stage Problem (nothing lost), no
 //     exception but groundplan::Error;
 //   - for every input, valid or not (issue 20, snap rounding): every plan valid by GEOS, no two plans
-//     overlapping, no ROUNDING_INVALID; near-touching output vertices (tests/support/near_touch.h)
-//     reported, not failed (open: snap_round.h kSnapNearTouch);
+//     overlapping, no ROUNDING_INVALID, no near-touching output vertices (tests/support/near_touch.h);
 //   - when every input polygon is valid by GEOS: the areas agree within 1e-6 (relative).
 // Polygon and hole counts are reported (stderr, first few), not asserted: on near-degenerate input
 // GEOS itself may be the odd one out (it snaps; we are exact).
@@ -92,11 +91,10 @@ GROUNDPLAN_FUZZ_TARGET(union) {
   // invalid or overlapping, snap rounding makes it valid and disjoint by construction).
   if (c.invalid_ours) groundplan_fuzz_fail("union", ("invalid plan: " + c.first_invalid_reason).c_str());
   if (c.overlapping_ours) groundplan_fuzz_fail("union", ("two plans overlap: " + c.summary()).c_str());
-  // Near-touch artefacts of valid output: still open, reported (snap_round.h, kSnapNearTouch).
+  // Near-touching output (vertices closer than a few ulps that are not one vertex): a failure for every
+  // input (issue 20: vertices closer than the snap pitch are one vertex).
   const groundplan::testing::NearTouch nt = groundplan::testing::near_touch(plans);
-  static int near_reported = 0;
-  if (nt.pairs && near_reported++ < 3)
-    std::fprintf(stderr, "groundplan fuzz union: near-touch artefact (open, issue 20): %s\n", nt.first.c_str());
+  if (nt.pairs) groundplan_fuzz_fail("union", ("near-touching output: " + nt.first).c_str());
   for (const Problem& p : problems)
     if (p.code == "ROUNDING_INVALID") groundplan_fuzz_fail("union", ("ROUNDING_INVALID: " + p.reason).c_str());
   const double tol = 1e-6 * std::max(c.area_geos, 1.0);

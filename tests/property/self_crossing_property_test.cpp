@@ -3,35 +3,26 @@
 // spikes, rings through their own vertex, pentagrams; sevenths and elevenths) next to ordinary quads,
 // 1000 seeded cases and a city of 3000 footprints at UTM coordinates.
 //
-// Held now, asserted: no exception; no problem but NO_AREA; every plan valid (GEOS isValid); no two
-// plans overlapping (3 in 1000 cases did before robust::crossing_point rounded each crossing once); the
-// plans cover exactly the even-odd region of the input (exact point membership at random points,
-// an oracle independent of GEOS).
-// Open (tests/corpus/fuzz-regressions/union/README.md), counted and printed, asserted only by the
-// DISABLED_ tests (run them with --gtest_also_run_disabled_tests). Branch snap-round2: 965 of 1000
-// cases strict-equal; 32 near-touch (valid output that near-touches is not snap-rounded:
-// snap_round.h kSnapNearTouch), 11 other polygon/hole counts; with near-touch snapped too (the
-// constant on) 990/1000, 1 near-touch, but large_offsets cases then differ from GEOS in counts.
-// Branch robust20 (touch_cycle: a hole touching its shell twice is snap-rounded): 970 strict-equal,
-// 27 near-touch, 12 other counts; constant on: 990, 1 near-touch, 12 other counts. Branch robust20c
-// (kSnapComputedNearTouch: a valid group near-touching at a computed point is snapped too, unless that
-// changes its ring counts): 986 strict-equal, 12 other counts, 8 near-touch (7 at a computed point).
-// Branch robust20d (nesting_flips: a ring turned over by rounding is snap-rounded): the same 986; the 14 open
-// seeds (printed one a line by the DISABLED_ test), read one by one against GEOS's WKT:
-//  - 20000025: a hole ring that crosses itself as a pentagram and sticks out of its shell: by parity its inner
-//    pentagon stays covered, GEOS MakeValid leaves it out (area 4.8% off); the even-odd sampling agrees with us.
-//  - 20000279, 20000440, 20000679, 20000704: GEOS keeps a feature narrower than the snap pitch (a hole or a sliver
-//    plan whose vertices are an ulp apart, a gap of an ulp between pieces) that snap rounding collapses, as
-//    designed (docs/union_engine.md, "What collapses"); valid, same area.
-//  - 20000837: f0's corner (2/7, 4/7 as doubles) lies exactly on f1's edge (checked with rationals): we give two
-//    plans sharing that vertex, GEOS moves it an ulp and gives one plan with a hole.
-//  - near-touch, 8: 20000261 between input vertices and edges only (GEOS's output has it too); 7 at a computed
-//    point, kept as they are because snapping their group would change its ring counts (the guard of
-//    kSnapComputedNearTouch). Snapping would give GEOS's counts in 20000668, 20000840, 20000992 and not in
-//    20000021, 20000223, 20000634, 20000793 (in 20000021 a dart-shaped sliver plan narrower than the pitch, which
-//    GEOS keeps, collapses); a rule telling the two apart without GEOS was not found.
-// So no engine defect is left among them that this test can show: they are sub-pitch decisions where the
-// strict criterion takes GEOS's rounding as the truth. The tests stay DISABLED_ (never loosened).
+// Asserted, every case: no exception; no problem but NO_AREA; every plan valid (GEOS isValid); no two plans
+// overlapping; the plans cover exactly the even-odd region of the input (exact point membership at random
+// points, an oracle independent of GEOS); no near-touching output vertices (tests/support/near_touch.h).
+// Asserted, every case but the open seed named below: DESIGN.md's criterion against GEOS MakeValid +
+// UnaryUnion, where counts and area may differ only by material narrower than the snap pitch
+// (GeosComparison::below_pitch: issue 20's "features narrower than δ collapse"). 999 of 1000.
+// The DISABLED_ tests assert it for all 1000 and the city, and fail on these (run them with
+// --gtest_also_run_disabled_tests). Open:
+//  - 20000025: a hole ring that crosses itself as a pentagram and sticks out of its shell: by parity (the
+//    engine's rule for every ring) its inner pentagon stays covered; GEOS MakeValid's linework method leaves
+//    it out and adds collapsed lines (area 4.8% off). The even-odd sampling agrees with us. The issue takes
+//    MakeValid and parity for one rule; here they are not.
+//  - the city of 3000 footprints has no near-touch (asserted) but holds such pentagram holes too: its area is
+//    1e-5 relative off GEOS MakeValid's (570 plans and 782 holes vs GEOS 571 and 784).
+// Closed by reading them against the rule "differences narrower than the pitch": 20000837 (f0's corner lies
+// exactly on f1's edge, checked with rationals: we give two plans sharing that vertex, GEOS one plan with a
+// hole; the symmetric difference is empty), and the seeds where a gap, neck or hole narrower than the pitch
+// closed or collapsed.
+// History: 965/1000 (snap-round2), 986 (robust20c/d: computed near-touch snapped unless counts changed), 999
+// (every near-touching group snapped; differences below the pitch accepted, measured piece by piece).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,13 +38,16 @@ namespace {
 
 struct Tally {
   int cases = 0, strict_ok = 0, counts_differ = 0, overlapping = 0, near_touch = 0, near_touch_computed = 0;
+  int counts_not_below_pitch = 0;  // counts differ from GEOS by more than features narrower than the pitch
   std::vector<std::string> hard;  // failures of what is asserted now
   std::string first_open;         // first failure of the strict criterion
   std::vector<std::string> open;  // every failure of the strict criterion, one line each
+  std::vector<std::uint64_t> open_seeds;
   void print(const char* what) const {
     std::cout << "[ " << what << " ] " << cases << " cases: " << strict_ok
               << " equal to GEOS MakeValid + UnaryUnion by DESIGN.md's criterion; open: " << overlapping
-              << " with overlapping plans, " << counts_differ << " with other polygon/hole counts, " << near_touch
+              << " with overlapping plans, " << counts_differ << " with other polygon/hole counts (" << counts_not_below_pitch
+              << " of them by more than features narrower than the snap pitch), " << near_touch
               << " with near-touching vertices (" << near_touch_computed << " at a point the union computed)\n";
   }
 };
@@ -76,9 +70,12 @@ void check(const std::vector<Footprint>& fps, std::uint64_t seed, int samples, T
   const testing::NearTouch nt = testing::near_touch(c.plans, 8, &fps);
   t.strict_ok += c.ok && nt.pairs == 0;
   t.counts_differ += !c.counts_match;
+  t.counts_not_below_pitch += !(c.cmp.counts_exact() || c.cmp.below_pitch());
   t.overlapping += c.cmp.overlapping_ours > 0;
   t.near_touch += nt.pairs > 0;
   t.near_touch_computed += nt.computed > 0;
+  if (nt.pairs) hard("near-touching output: " + nt.first);
+  if (!c.ok || nt.pairs) t.open_seeds.push_back(seed);
   if (!c.ok || nt.pairs)
     t.open.push_back("seed " + std::to_string(seed) + ": " + (nt.pairs ? "near-touch " + nt.first + "; " : "") +
                      c.cmp.summary());
@@ -110,6 +107,15 @@ TEST(SelfCrossingRings, ValidAndEvenOddRegion) {
   t.print("self-crossing rings");
   EXPECT_EQ(t.cases, 1000);
   for (std::size_t i = 0; i < t.hard.size() && i < 3; ++i) ADD_FAILURE() << t.hard[i];
+}
+
+// Issue 20's strict criterion on every seed but the open one (see the header), which must still fail it:
+// one that passes is taken off the list.
+TEST(SelfCrossingRings, MatchesGeosMakeValidUnionButTheOpenSeeds) {
+  const Tally t = run_cases();
+  const std::vector<std::uint64_t> open{20000025};
+  EXPECT_EQ(t.open_seeds, open);
+  for (const std::string& o : t.open) std::cout << "  open: " << o << "\n";
 }
 
 TEST(SelfCrossingCity, ValidAndEvenOddRegion) {

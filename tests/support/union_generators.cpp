@@ -88,6 +88,9 @@ const char* family_name(Family f) {
     case Family::Holes: return "holes";
     case Family::RandomOverlap: return "random_overlap";
     case Family::NearCollinear: return "near_collinear";
+    case Family::DenseRings: return "dense_rings";
+    case Family::VertexOnEdge: return "vertex_on_edge";
+    case Family::CityFineFeatures: return "city_fine_features";
   }
   return "?";
 }
@@ -275,6 +278,84 @@ std::vector<Footprint> generate_case(Family fam, Rng& r) {
     case Family::RandomOverlap: {
       const int n = uint_(r, 2, 12);
       for (int i = 0; i < n; ++i) out.push_back(fp_of(star(r, uni(r, 0, 30), uni(r, 0, 30), 1, 10, uint_(r, 3, 12))));
+      break;
+    }
+    case Family::DenseRings: {
+      // isochrones: smooth-ish rings whose radius wanders, thousands of vertices, overlapping; some with a hole
+      const int n = uint_(r, 2, 4);
+      const double ox = coin(r) ? 0 : uni(r, 3e5, 6e5), oy = coin(r) ? 0 : uni(r, 5e6, 6e6);
+      for (int i = 0; i < n; ++i) {
+        const int m = uint_(r, 200, 3000);
+        const double cx = ox + uni(r, 0, 400), cy = oy + uni(r, 0, 400), base = uni(r, 100, 300);
+        Ring ring;
+        double rad = base;
+        for (int k = 0; k < m; ++k) {
+          rad = std::clamp(rad + uni(r, -0.02, 0.02) * base, 0.5 * base, 1.5 * base);
+          const double a = 2 * std::numbers::pi * k / m;
+          ring.push_back({cx + rad * std::cos(a), cy + rad * std::sin(a)});
+        }
+        std::vector<Ring> holes;
+        if (coin(r, 0.3)) holes.push_back(star(r, cx, cy, 0.1 * base, 0.3 * base, uint_(r, 50, 400)));
+        maybe_reverse(r, ring);
+        out.push_back(fp_of(ring, holes));
+      }
+      break;
+    }
+    case Family::VertexOnEdge: {
+      // inexact quads; each later polygon has a vertex at a + t (b - a) on an edge of an earlier one (a point
+      // within rounding of that edge, exactly on it only by chance), pointing out of it or into it
+      const int n = uint_(r, 2, 6);
+      const double ox = coin(r) ? 0 : uni(r, 1e5, 1e7), oy = coin(r) ? 0 : uni(r, 1e5, 1e7);
+      std::vector<Ring> rings;
+      rings.push_back({{ox + uni(r, 0, 1), oy + uni(r, 0, 1)}, {ox + uni(r, 9, 10), oy + uni(r, 0, 1)},
+                       {ox + uni(r, 9, 10), oy + uni(r, 9, 10)}, {ox + uni(r, 0, 1), oy + uni(r, 9, 10)}});
+      for (int i = 1; i < n; ++i) {
+        const Ring& host = rings[static_cast<std::size_t>(uint_(r, 0, i - 1))];
+        const std::size_t e = static_cast<std::size_t>(uint_(r, 0, static_cast<int>(host.size()) - 1));
+        const Point2 a = host[e], b = host[(e + 1) % host.size()];
+        const double t = uni(r, 0.1, 0.9);
+        const Point2 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+        // outward normal of a counter-clockwise host is (dy, -dx); inward its opposite
+        const double len = std::hypot(b.x - a.x, b.y - a.y), s = coin(r) ? 1 : -1, d = uni(r, 1, 4);
+        const double nx = s * (b.y - a.y) / len, ny = -s * (b.x - a.x) / len, ux = (b.x - a.x) / len, uy = (b.y - a.y) / len;
+        Ring tri{p, {p.x + d * nx + d * ux, p.y + d * ny + d * uy}, {p.x + d * nx - d * ux, p.y + d * ny - d * uy}};
+        if (s > 0 && coin(r)) tri.push_back({p.x + 2 * d * nx, p.y + 2 * d * ny});  // a quad, vertex still on the edge
+        rings.push_back(tri);
+      }
+      for (Ring& ring : rings) {
+        maybe_reverse(r, ring);
+        out.push_back(fp_of(ring));
+      }
+      break;
+    }
+    case Family::CityFineFeatures: {
+      // buildings at city coordinates with a feature of one width each: a gap to a neighbour, a sliver
+      // between two, a hole, a spike; widths from a millimetre down to a nanometre
+      const double ox = uni(r, 1e6, 1e7), oy = uni(r, 1e6, 1e7);
+      const double widths[] = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9};
+      const int n = uint_(r, 1, 4);
+      for (int i = 0; i < n; ++i) {
+        const double w = widths[uint_(r, 0, 6)];
+        const double x = ox + 30 * i + dy(uni(r, 0, 5)), y = oy + dy(uni(r, 0, 5));
+        const double a = dy(uni(r, 4, 12)), b = dy(uni(r, 4, 12));
+        switch (uint_(r, 0, 3)) {
+          case 0:  // two houses w apart
+            out.push_back(fp_of(rect(x, y, x + a, y + b)));
+            out.push_back(fp_of(rect(x + a + w, y, x + 2 * a, y + b)));
+            break;
+          case 1:  // two overlapping houses with a sliver of union w wide between two others
+            out.push_back(fp_of(rect(x, y, x + a, y + b)));
+            out.push_back(fp_of(rect(x + a - w, y + 1, x + 2 * a, y + b - 1)));
+            break;
+          case 2:  // a courtyard w wide
+            out.push_back(fp_of(rect(x, y, x + a, y + b), {rect(x + 1, y + 1, x + 1 + w, y + b - 1)}));
+            break;
+          default:  // a spike w wide out of a wall
+            out.push_back(fp_of({{x, y}, {x + a, y}, {x + a, y + b / 2}, {x + a + 3, y + b / 2 + w / 2},
+                                 {x + a, y + b / 2 + w}, {x + a, y + b}, {x, y + b}}));
+            break;
+        }
+      }
       break;
     }
   }

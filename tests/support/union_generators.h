@@ -28,13 +28,19 @@ enum class Family {
   RandomOverlap,     // random star-shaped polygons overlapping
   NearCollinear,     // party walls rotated by any angle: walls collinear only up to rounding, so
                      // gaps and overlaps far below one ulp (GEOS may snap them; see the test)
+  DenseRings,        // isochrone-like rings of 200 to 3000 vertices overlapping one another (issue 20)
+  VertexOnEdge,      // a vertex of one polygon put on another's inexact edge (a + t (b - a) in doubles,
+                     // so within rounding of it), from outside and from inside (issue 20)
+  CityFineFeatures,  // city coordinates (1e6..1e7 m) with gaps, slivers and holes 1 mm to 1 nm wide
+                     // (issue 20)
 };
 const char* family_name(Family f);
 constexpr Family kAllFamilies[] = {Family::PartyWalls,   Family::CollinearOverlap, Family::VertexTouch,
                                    Family::Nested,       Family::Duplicates,       Family::BowTies,
                                    Family::RepeatedPoints, Family::Slivers,        Family::LargeOffsets,
                                    Family::RotatedBlocks, Family::Holes,           Family::RandomOverlap,
-                                   Family::NearCollinear};
+                                   Family::NearCollinear, Family::DenseRings,      Family::VertexOnEdge,
+                                   Family::CityFineFeatures};
 
 /// One random case of the family (a few to a few dozen footprints).
 std::vector<Footprint> generate_case(Family f, Rng& rng);

@@ -24,6 +24,10 @@ struct UnionCheck {
   bool geos_symdiff_implausible = false;  // counts, areas, validity agree but GEOS's symmetric difference
                                           // did not: decided by sampling instead
   bool counts_match = false;
+  /// Counts differ from GEOS's exact union, every difference a gap, neck or hole narrower than the snap
+  /// pitch (GeosComparison::below_pitch), all else matching: features narrower than the pitch
+  /// collapsed, as issue 20 asks. Strict accepts that (GeosComparison::matches); it is counted here.
+  bool collapsed_below_pitch = false;
   std::string message;  // summary + input WKT when not ok
 };
 
@@ -32,6 +36,9 @@ enum class Oracle {
   AreaAndValid, // only area within rel_tol and every plan valid: for inputs whose features are far
                 // below one ulp, where GEOS's snapping and relate are not exact (see the property test)
 };
+
+/// The engine's snap pitch for these footprints (snap_pitch of their largest coordinate).
+double snap_pitch_of(const std::vector<Footprint>& fps);
 
 /// Runs build_ground_plans (single thread unless threads given) and compares with GEOS UnaryUnion;
 /// also checks our own promises: outer CCW, holes CW, members non-empty. When GEOS's result is not

@@ -37,4 +37,10 @@ struct UnionParams {
 std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footprints, const UnionParams& params,
                                            std::vector<Problem>& problems, const Progress& progress = {});
 
+/// The grid of the union's snap rounding (issue 20, docs/union_engine.md "Snap rounding") for coordinates of
+/// magnitude up to `max_abs`: 16 units in the last place of max_abs, a power of two (1.5e-8 m at UTM
+/// northings). Output vertices closer than it are one vertex, and features narrower than it collapse;
+/// each block of touching footprints is rounded on the pitch of its own largest coordinate.
+double snap_pitch(double max_abs);
+
 }  // namespace groundplan

@@ -45,7 +45,6 @@ struct Poly {
 struct RingOut {
   std::vector<Point2> pts;
   bool rounded = false;  // some vertex is a rounded crossing point (else every vertex is exact input)
-  std::vector<Point2> crossings;  // those rounded crossing points (the points the union computed)
   std::vector<std::uint32_t> polys;  // polygons whose area borders this ring
 };
 

@@ -585,7 +585,6 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     // (the ring touches itself there); split_simple needs to see it, then drops straight vertices
     ring.pts.push_back(point_of(L, x0));
     ring.rounded |= x0.cross;
-    if (x0.cross) ring.crossings.push_back(ring.pts.back());
     group.assign(rays.begin() + static_cast<std::ptrdiff_t>(g0), rays.begin() + static_cast<std::ptrdiff_t>(g1));
     L = Line(out.edge, out.from, out.to);
     cur = next;
@@ -804,7 +803,9 @@ BlockResult union_block(const std::vector<Footprint>& footprints, const std::vec
                         double pitch) {
   thread_local BlockEngine engine;
   engine.reset(footprints, members, pitch);
-  return engine.run();
+  BlockResult r = engine.run();
+  r.pitch = pitch;
+  return r;
 }
 
 }  // namespace groundplan::detail

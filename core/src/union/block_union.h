@@ -22,14 +22,17 @@ struct BlockResult {
   std::vector<GroundPlan> plans;
   std::vector<Problem> problems;
   BlockStats stats;
+  std::vector<std::uint32_t> snapped;  // footprints bordering a snap-rounded group (for the message of one
+                                       // that collapsed: narrower than the pitch, in no plan)
+  double pitch = 0;                    // the block's snap-rounding grid
 };
 
 /// The exact union of the footprints `members` (indices into `footprints`): one GroundPlan per
 /// connected polygon, outer ring counter-clockwise, holes clockwise. Each input polygon counts by
 /// the even-odd rule over its rings (its valid repair, as GEOS MakeValid gives it). Throws
 /// TopologyError if a boundary walk does not close (never expected: every decision is exact).
-/// `pitch`: the snap-rounding grid of the whole call (snap_pitch of its largest coordinate), used
-/// when the block's boundary has crossing points.
+/// `pitch`: the block's snap-rounding grid (snap_pitch of its largest coordinate magnitude), used where
+/// the block's boundary as rounded is not clean or near-touches (snap_round.h).
 BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members,
                         double pitch);
 

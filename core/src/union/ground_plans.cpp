@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <string>
 #include <thread>
@@ -48,13 +49,18 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     fps.indices.push_back(all.indices[k]);
     fps.boxes.push_back(all.boxes[k]);
   }
-  // Snap rounding (issue 20): one grid for the whole call, from its largest coordinate magnitude. A
-  // block with crossing points is snap-rounded, its vertices moving by up to g/sqrt(2); boxes grown by
-  // 4g put footprints closer than that into one block, so that blocks stay more than 2g apart and
-  // their roundings never meet.
+  // Snap rounding (issue 20): each block on the grid of its own largest coordinate magnitude, at most
+  // the call's pitch g. A snapped block's vertices move by up to g/sqrt(2); boxes grown by 4g put
+  // footprints closer than that into one block, so that blocks stay more than 2g apart and their
+  // roundings never meet.
   double max_abs = 0;
-  for (const FootprintSet::Box& b : fps.boxes)
-    max_abs = std::max({max_abs, std::fabs(b.minx), std::fabs(b.miny), std::fabs(b.maxx), std::fabs(b.maxy)});
+  std::vector<double> magnitude(footprints.size(), 0);  // per footprint, for its block's pitch
+  for (std::size_t k = 0; k < fps.boxes.size(); ++k) {
+    const FootprintSet::Box& b = fps.boxes[k];
+    const double m = std::max({std::fabs(b.minx), std::fabs(b.miny), std::fabs(b.maxx), std::fabs(b.maxy)});
+    magnitude[fps.indices[k]] = m;
+    max_abs = std::max(max_abs, m);
+  }
   const double pitch = detail::snap_pitch(max_abs);
   for (FootprintSet::Box& b : fps.boxes) {
     b.minx -= 4 * pitch;
@@ -86,7 +92,9 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   auto one = [&](std::size_t oi) {
     const std::size_t bi = order[oi];
     try {
-      results[bi] = detail::union_block(*src, blocks[bi].footprints, pitch);
+      double block_abs = 0;
+      for (std::uint32_t fi : blocks[bi].footprints) block_abs = std::max(block_abs, magnitude[fi]);
+      results[bi] = detail::union_block(*src, blocks[bi].footprints, detail::snap_pitch(block_abs));
     } catch (const TopologyError& e) {
       detail::BlockResult r;
       for (std::uint32_t fi : blocks[bi].footprints)
@@ -114,6 +122,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   std::vector<GroundPlan> plans(first.back());
   std::vector<char> member(footprints.size(), 0);  // a footprint is in one block: no two blocks write one entry
   std::vector<char> failed(footprints.size(), 0);
+  std::vector<double> snapped_at(footprints.size(), 0);  // the pitch of a snap-rounded group it bordered
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, results.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t bi = r.begin(); bi != r.end(); ++bi) {
@@ -126,6 +135,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     });
   });
   for (std::size_t bi = 0; bi < results.size(); ++bi) {
+    for (std::uint32_t fi : results[bi].snapped) snapped_at[fi] = results[bi].pitch;
     for (Problem& p : results[bi].problems) {
       if (p.code == "UNION_FAILED")
         for (std::uint32_t fi : blocks[bi].footprints) failed[fi] = 1;
@@ -133,16 +143,26 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     }
   }
   // Nothing is dropped silently: a footprint with non-collinear points can still have no area
-  // under the even-odd rule (rings that retrace themselves: A-B-C-B). It is in no plan; say so.
+  // under the even-odd rule (rings that retrace themselves: A-B-C-B), or be narrower than the snap
+  // grid of its coordinates everywhere (issue 20: features narrower than the pitch collapse). It is in
+  // no plan; say so.
   for (std::uint32_t fi : fps.indices) {
     if (member[fi] || failed[fi]) continue;
-    problems.push_back(Problem{footprints[fi].source_id, footprints[fi].source_file, "union", "NO_AREA",
-                               "the footprint's rings enclose no area (they retrace or cancel themselves): not in any plan"});
+    std::string why = "the footprint's rings enclose no area (they retrace or cancel themselves): not in any plan";
+    if (snapped_at[fi] > 0) {
+      char g[32];
+      std::snprintf(g, sizeof g, "%.3g", snapped_at[fi]);
+      why = std::string("the footprint is narrower than the snap-rounding grid of its coordinates (") + g +
+            " m, 16 units in the last place) and collapsed, or its rings cancel themselves: not in any plan";
+    }
+    problems.push_back(Problem{footprints[fi].source_id, footprints[fi].source_file, "union", "NO_AREA", why});
   }
   progress.report(1.0, "ground plans");
   if (params.stats)
     params.stats->union_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_union).count();
   return plans;
 }
+
+double snap_pitch(double max_abs) { return detail::snap_pitch(max_abs); }
 
 }  // namespace groundplan

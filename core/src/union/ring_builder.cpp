@@ -105,16 +105,18 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
     bool snapped;
   };
   // Simple rings with the polygons bordering them. Walks that are all exact (every vertex an input
-  // vertex) are the exact boundary: split at revisited vertices and kept bit for bit. A group of
-  // nearby walks with a rounded crossing point is snap-rounded as a whole (snap_round.h).
+  // vertex) are the exact boundary: split at revisited vertices and kept bit for bit, unless they
+  // near-touch. A group of nearby walks that is not clean is snap-rounded as a whole (snap_round.h).
   std::vector<std::vector<Point2>> parts;
   std::vector<std::vector<std::uint32_t>> parts_polys;
   std::vector<std::size_t> part_src;  // parts[k] has the polygons parts_polys[part_src[k]]
   std::vector<char> parts_snapped;    // parts[k] comes from snap rounding
-  // Walks split as they are (crossings correctly rounded). Exact walks are the exact boundary. If some
-  // walk has a rounded crossing and the whole block's rings are not clean (clean_as_rounded: valid and
-  // disjoint), the walks are grouped by proximity (groups more than 4 pitches apart are independent)
-  // and each group with a crossing whose rings are not clean is snap-rounded; the others stay as split.
+  // Walks split as they are (crossings correctly rounded). Exact walks are the exact boundary. The
+  // block is snap-rounded where that is not clean: a walk with a rounded crossing whose rings, as
+  // rounded, are invalid, overlap or turned over, or output vertices closer than a pitch to another vertex
+  // or edge, whether the union computed them or the input had them (issue 20: "vertices closer than δ
+  // are one vertex"). Then the walks are grouped by proximity (groups more than 4 pitches apart are
+  // independent) and each group that is not clean is snap-rounded; the others stay as split.
   bool any_rounded = false;
   for (const RingOut& r : rings_) any_rounded |= r.rounded;
   std::vector<std::size_t> first_part(rings_.size() + 1, 0);
@@ -129,16 +131,6 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
     for (std::size_t i = 0; i < rings_.size(); ++i)
       for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) part_rounded[k] = rings_[i].rounded;
   }
-  // With kSnapComputedNearTouch, a group is also rounded where a computed point near-touches (the walks'
-  // rounded crossings, sorted, tell computed points from input ones).
-  constexpr bool near = kSnapNearTouch || kSnapComputedNearTouch;
-  std::vector<Point2> computed;
-  if (any_rounded && kSnapComputedNearTouch && !kSnapNearTouch) {
-    for (const RingOut& r : rings_) computed.insert(computed.end(), r.crossings.begin(), r.crossings.end());
-    std::sort(computed.begin(), computed.end(), [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    computed.erase(std::unique(computed.begin(), computed.end()), computed.end());
-  }
-  const std::vector<Point2>* near_computed = kSnapNearTouch ? nullptr : &computed;
   // A ring with a rounded crossing may have turned over (a sliver hole come out as an outer ring inside
   // another plan): its group is snap-rounded like an invalid one, even where it is far from every other walk.
   std::vector<char> part_flipped;
@@ -147,16 +139,13 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
     part_flipped = nesting_flips(parts, part_rounded);
     any_flipped = std::find(part_flipped.begin(), part_flipped.end(), 1) != part_flipped.end();
   }
-  if (any_rounded && (any_flipped || !clean_near_rounded(parts, part_rounded, pitch, near, near_computed))) {
+  if (near_touching(parts, pitch) || (any_rounded && (any_flipped || !clean_near_rounded(parts, part_rounded, pitch)))) {
     const std::vector<std::uint32_t> group = proximity_groups(rings_, pitch);
-    std::vector<char> has_cross(rings_.size(), 0), has_flip(rings_.size(), 0);
-    for (std::size_t i = 0; i < rings_.size(); ++i) {
-      has_cross[group[i]] |= rings_[i].rounded;
-      for (std::size_t k = first_part[i]; k < first_part[i + 1] && any_flipped; ++k) has_flip[group[i]] |= part_flipped[k];
-    }
+    std::vector<char> has_flip(rings_.size(), 0);
+    for (std::size_t i = 0; i < rings_.size() && any_flipped; ++i)
+      for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) has_flip[group[i]] |= part_flipped[k];
     std::vector<std::vector<std::uint32_t>> members(rings_.size());
-    for (std::uint32_t i = 0; i < rings_.size(); ++i)
-      if (has_cross[group[i]]) members[group[i]].push_back(i);
+    for (std::uint32_t i = 0; i < rings_.size(); ++i) members[group[i]].push_back(i);
     std::vector<std::vector<Point2>> snapped_parts;
     std::vector<std::vector<std::uint32_t>> snapped_polys;
     for (std::uint32_t gi = 0; gi < rings_.size(); ++gi) {
@@ -164,40 +153,25 @@ void assemble_block(const std::vector<RingOut>& rings_, const std::vector<Poly>&
       std::vector<std::vector<Point2>> as_is;
       for (std::uint32_t i : members[gi])
         for (std::size_t k = first_part[i]; k < first_part[i + 1]; ++k) as_is.push_back(parts[k]);
-      if (!has_flip[gi] && members[gi].size() < rings_.size() && clean_as_rounded(as_is, pitch, near, near_computed))
-        continue;
-      // Valid and disjoint as it is, only near-touching at a computed point: it is snap-rounded only if that
-      // keeps its numbers of outer rings and holes. Snapping closes gaps and necks narrower than a pitch
-      // (walls an ulp apart in the input), which joins or splits plans where GEOS and the exact union
-      // do not (large_offsets seeds 9000814, 9000823, 9000867); those keep their near-touch.
-      const bool only_near = near && !has_flip[gi] && clean_as_rounded(as_is, pitch, false);
+      if (!has_flip[gi] && members[gi].size() < rings_.size() && clean_as_rounded(as_is, pitch, true)) continue;
       std::vector<RingOut> sub;
       for (std::uint32_t i : members[gi]) sub.push_back(rings_[i]);
       std::vector<SnappedRing> sr;
       SnapStats ss;
       if (!snap_round(sub, pitch, sr, ss)) {
-        if (only_near) continue;  // the rings as they are are valid: nothing to report
+        // cannot happen (docs/union_engine.md); rings that are valid as they are stay, only near-touching
+        if (!has_flip[gi] && clean_as_rounded(as_is, pitch, false)) continue;
         out.problems.push_back(Problem{"", "", "union", "ROUNDING_INVALID",
                                        "snap rounding of a boundary did not give a consistent edge graph; "
                                        "its crossing points are rounded to nearest instead"});
         continue;
       }
-      if (only_near) {
-        auto counts = [](auto begin, auto end, auto pts_of) {
-          std::pair<std::size_t, std::size_t> c{0, 0};  // outer rings, holes
-          for (auto it = begin; it != end; ++it) {
-            const int o = ring_orientation(pts_of(*it));
-            c.first += o > 0, c.second += o < 0;
-          }
-          return c;
-        };
-        const auto before = counts(as_is.begin(), as_is.end(), [](const std::vector<Point2>& r) -> const std::vector<Point2>& { return r; });
-        const auto after = counts(sr.begin(), sr.end(), [](const SnappedRing& r) -> const std::vector<Point2>& { return r.pts; });
-        if (before != after) continue;
-      }
       stats_.snapped_groups += 1;
       stats_.rounding_repairs += ss.cancelled;
-      for (std::uint32_t i : members[gi]) walk_snapped[i] = 1;
+      for (std::uint32_t i : members[gi]) {
+        walk_snapped[i] = 1;
+        for (std::uint32_t p : rings_[i].polys) out.snapped.push_back(polys_[p].footprint);
+      }
       for (SnappedRing& r : sr) {
         snapped_parts.push_back(std::move(r.pts));
         snapped_polys.push_back(std::move(r.polys));

@@ -413,85 +413,22 @@ std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, d
 
 namespace {
 
-/// Whether a point the union computed (in `computed`, sorted by x then y) is within `pitch` of a vertex
-/// or edge of `rings` it is not on, or an edge with a computed end is within `pitch` of another vertex.
-/// Computed points are few (rounded crossings): two small grids, one of them and one of the edges that
-/// end at one, and one pass over all edges and one over all vertices.
-bool computed_near_touch(const std::vector<std::vector<Point2>>& rings, double pitch, const std::vector<Point2>& computed) {
-  auto xy = [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); };
-  std::vector<Point2> cpts;             // computed vertices
-  std::vector<Box> cpb, ceb;            // their boxes; boxes of edges with a computed end, grown by pitch
-  std::vector<std::pair<Point2, Point2>> cedges;
-  Box call, eall;
-  for (const auto& r : rings) {
-    const std::size_t n = r.size();
-    std::vector<char> comp(n);
-    for (std::size_t i = 0; i < n; ++i) comp[i] = std::binary_search(computed.begin(), computed.end(), r[i], xy);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (comp[i]) {
-        cpts.push_back(r[i]);
-        Box b;
-        b.add(r[i]);
-        cpb.push_back(b);
-        call.add(r[i]);
-      }
-      if (comp[i] || comp[(i + 1) % n]) {
-        cedges.emplace_back(r[i], r[(i + 1) % n]);
-        Box b;
-        b.add(r[i]);
-        b.add(r[(i + 1) % n]);
-        b.grow(pitch);
-        ceb.push_back(b);
-        eall.add({b.minx, b.miny});
-        eall.add({b.maxx, b.maxy});
-      }
-    }
-  }
-  if (cpts.empty()) return false;
-  const long double d = pitch;
-  bool found = false;
-  std::size_t nv = 0;
-  for (const auto& r : rings) nv += r.size();
-  if ((cpts.size() + cedges.size()) * nv <= 4096) {  // small: every pair (no grid to build)
-    for (const auto& r : rings)
-      for (std::size_t i = 0; i < r.size() && !found; ++i) {
-        const Point2& a = r[i];
-        const Point2& b = r[(i + 1) % r.size()];
-        for (const Point2& c : cpts)
-          if (!(c == a) && !(c == b) && dist_to_segment(c, a, b) <= d) found = true;
-        for (const auto& [p, q2] : cedges)
-          if (!(a == p) && !(a == q2) && dist_to_segment(a, p, q2) <= d) found = true;
-      }
-    return found;
-  }
-  BoxGrid pgrid, egrid;
-  pgrid.build(cpb, call, cpb.size());
-  egrid.build(ceb, eall, ceb.size());
-  for (const auto& r : rings)
-    for (std::size_t i = 0; i < r.size() && !found; ++i) {
-      const Point2& a = r[i];
-      const Point2& b = r[(i + 1) % r.size()];
-      Box q;  // computed vertices near this edge
-      q.add(a);
-      q.add(b);
-      q.grow(pitch);
-      pgrid.query(q, [&](std::uint32_t k) {
-        if (!found && !(cpts[k] == a) && !(cpts[k] == b) && dist_to_segment(cpts[k], a, b) <= d) found = true;
-      });
-      Box v;  // edges with a computed end near this vertex
-      v.add(a);
-      egrid.query(v, [&](std::uint32_t e) {
-        const auto& [p, q2] = cedges[e];
-        if (!found && !(a == p) && !(a == q2) && dist_to_segment(a, p, q2) <= d) found = true;
-      });
-    }
-  return found;
+/// Whether p lies within d of the interior of segment ab without being exactly on it (exact contact, a
+/// T-junction, is how OGC plans touch; the ends are the vertex-vertex test's).
+bool near_interior(const Point2& p, const Point2& a, const Point2& b, long double d) {
+  if (p == a || p == b || orient(a, b, p) == 0) return false;
+  const long double dx = static_cast<long double>(b.x) - a.x, dy = static_cast<long double>(b.y) - a.y;
+  const long double px = static_cast<long double>(p.x) - a.x, py = static_cast<long double>(p.y) - a.y;
+  const long double l2 = dx * dx + dy * dy;
+  const long double t = l2 > 0 ? (px * dx + py * dy) / l2 : 0;
+  if (!(t > 0 && t < 1)) return false;
+  const long double ex = px - t * dx, ey = py - t * dy;
+  return ex * ex + ey * ey <= d * d;
 }
 
 }  // namespace
 
-bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near,
-                      const std::vector<Point2>* computed) {
+bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near) {
   {
     std::vector<std::vector<Point2>*> rr;
     for (const auto& r : rings) rr.push_back(const_cast<std::vector<Point2>*>(&r));
@@ -501,41 +438,65 @@ bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitc
     // is invalid (interior disconnected): the 9ec94c3b fuzz regression
     if (touch_cycle(rr)) return false;
   }
-  if (!near) return true;
-  if (computed) return !computed_near_touch(rings, pitch, *computed);
+  return !near || !near_touching(rings, pitch);
+}
+
+bool near_touching(const std::vector<std::vector<Point2>>& rings, double pitch) {
   std::vector<Point2> pts;
-  std::vector<Box> pb;
-  Box all;
-  for (const auto& r : rings)
-    for (const Point2& p : r) {
-      pts.push_back(p);
-      Box b;
-      b.add(p);
-      pb.push_back(b);
-      all.add(p);
-    }
-  if (pts.empty()) return true;
-  BoxGrid grid;
-  grid.build(pb, all, pb.size());
+  for (const auto& r : rings) pts.insert(pts.end(), r.begin(), r.end());
+  if (pts.size() < 2) return false;
+  const auto xy = [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); };
+  std::sort(pts.begin(), pts.end(), xy);
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   const long double d = pitch;
-  bool ok = true;
-  for (const auto& r : rings)
-    for (std::size_t i = 0; i < r.size() && ok; ++i) {
-      const Point2& a = r[i];
-      const Point2& b = r[(i + 1) % r.size()];
+  // vertex-vertex: distinct vertices within a pitch (a sweep by x; of the vertices with the same x only the
+  // next in y, so that thousands of vertices on one grid line cost no more than a pass)
+  for (std::size_t i = 0, k = 0; i < pts.size(); ++i) {
+    if (i + 1 < pts.size() && pts[i + 1].x == pts[i].x && pts[i + 1].y - pts[i].y <= pitch) return true;
+    k = std::max(k, i + 1);
+    while (k < pts.size() && pts[k].x == pts[i].x) ++k;  // the first vertex right of this x
+    for (std::size_t j = k; j < pts.size() && pts[j].x - pts[i].x <= pitch; ++j)
+      if (std::fabs(pts[j].y - pts[i].y) <= pitch) return true;
+  }
+  // vertex-edge: a vertex within a pitch of an edge's interior, not on it
+  bool found = false;
+  auto edges = [&](auto&& per_edge) {
+    for (const auto& r : rings)
+      for (std::size_t i = 0, n = r.size(); i < n && !found; ++i) per_edge(r[i], r[(i + 1) % n]);
+  };
+  if (pts.size() <= 48) {  // small: every pair behind a box test (no grid to build)
+    edges([&](const Point2& a, const Point2& b) {
       Box q;
       q.add(a);
       q.add(b);
       q.grow(pitch);
-      grid.query(q, [&](std::uint32_t k) {
-        if (ok && !(pts[k] == a) && !(pts[k] == b) && dist_to_segment(pts[k], a, b) <= d) ok = false;
-      });
-    }
-  return ok;
+      for (const Point2& p : pts)
+        if (q.contains(p) && near_interior(p, a, b, d)) {
+          found = true;
+          break;
+        }
+    });
+    return found;
+  }
+  std::vector<Box> pb(pts.size());
+  Box all;
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    pb[k].add(pts[k]);
+    all.add(pts[k]);
+  }
+  BoxGrid grid;
+  grid.build(pb, all, pb.size());
+  edges([&](const Point2& a, const Point2& b) {
+    Box q;
+    q.add(a);
+    q.add(b);
+    q.grow(pitch);
+    grid.query(q, [&](std::uint32_t k) { found = found || (q.contains(pts[k]) && near_interior(pts[k], a, b, d)); });
+  });
+  return found;
 }
 
-bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded,
-                        double pitch, bool near, const std::vector<Point2>* computed) {
+bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded, double pitch) {
   // only rings that can meet a rounded one: the others are exact and pairwise fine
   std::vector<Box> rb;
   Box all;
@@ -559,7 +520,7 @@ bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std
       grid.query(box[i], [&](std::uint32_t k) { take = take || box[i].overlaps(rb[k]); });
     if (take) sel.push_back(rings[i]);
   }
-  return clean_as_rounded(sel, pitch, near, computed);
+  return clean_as_rounded(sel, pitch, false);
 }
 
 double snap_pitch(double max_abs) {

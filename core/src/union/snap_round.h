@@ -35,29 +35,21 @@ struct SnapStats {
 /// group without crossing points can be output exactly. Returns a group id per walk, 0..n-1.
 std::vector<std::uint32_t> proximity_groups(const std::vector<RingOut>& walks, double pitch);
 
-/// Whether simple rings on their doubles (the walks split, crossings correctly rounded) are already
-/// clean: no two edges cross or overlap, no ring touches itself, and no vertex is within a pitch of
-/// an edge (or vertex) it is not equal to. Then snap rounding is not needed and would only move them.
-/// With `near` false only validity and disjointness are checked.
-/// clean_near_rounded: the same, on the rings flagged `rounded` and the others whose boxes come within
-/// a pitch of one of them (exact rings cannot conflict with each other).
-/// `computed` (sorted by x, then y; used only with `near`): the points the union computed (the walks'
-/// rounded crossings); a vertex near an edge then counts only if the vertex or an end of the edge is one
-/// of them. Pairs of input vertices and edges alone near-touch in the input itself, and the exact union
-/// keeps them.
-bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded,
-                        double pitch, bool near, const std::vector<Point2>* computed = nullptr);
-bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near,
-                      const std::vector<Point2>* computed = nullptr);
+/// Whether simple rings on their doubles (the walks split, crossings correctly rounded) are valid and
+/// disjoint: no two edges cross or overlap, no ring touches itself, no hole touches its shell twice.
+/// With `near`, also that they do not near-touch (near_touching). Then snap rounding is not needed and
+/// would only move them.
+bool clean_as_rounded(const std::vector<std::vector<Point2>>& rings, double pitch, bool near);
+/// clean_as_rounded without `near` on the rings flagged `rounded` and the others whose boxes come within a
+/// pitch of one of them (exact rings cannot cross each other).
+bool clean_near_rounded(const std::vector<std::vector<Point2>>& rings, const std::vector<char>& rounded, double pitch);
 
-/// Whether a valid group whose vertices merely near-touch is snap-rounded too. Off: snapping those
-/// closes gaps and necks narrower than a pitch, which changes plan counts against GEOS (at least 3
-/// cases of the large_offsets property family); the near-touch artefacts stay there (issue 20, open).
-constexpr bool kSnapNearTouch = false;
-/// Whether a valid group is snap-rounded where a point the union computed (a rounded crossing) is within a
-/// pitch of another vertex or edge: the near-touch artefacts of the union's own rounding, without the
-/// near-touches of the input (issue 20).
-constexpr bool kSnapComputedNearTouch = true;
+/// Whether two distinct vertices of `rings` are within a pitch of each other (in x and in y), or a vertex
+/// is within a pitch of the interior of an edge without being exactly on it. Output vertices that close
+/// are one vertex after snap rounding (issue 20: "output vertices closer than δ are one vertex"), whether
+/// the union computed them or the input had them; exact contact (equal vertices, a vertex exactly on an
+/// edge) is how OGC plans touch, and stays.
+bool near_touching(const std::vector<std::vector<Point2>>& rings, double pitch);
 
 /// Snap-rounds the closed walks of one block on the grid of pitch `pitch`. Returns false (and
 /// leaves `out` empty) only if the rounded boundary is not a consistent edge graph, which the

@@ -114,18 +114,26 @@ TEST(UnionTotalApi, SubnormalCoordinates) {
 }
 
 TEST(UnionTotalApi, EdgesOfTheAdmittedRangeAreComputedExactly) {
-  // magnitudes 2^-150 and 2^50 are admitted: squares there come out whole
+  // magnitudes 2^-150 and 2^50 are admitted: squares there come out whole. Each block is snap-rounded on
+  // the grid of its own magnitude (16 ulp: 2 m at 2^49, 1e-322 at 2^-149), so the tiny squares keep their
+  // size beside the far one; a square narrower than its grid collapses, and is reported as such.
   const double lo = 0x1p-150, hi = 0x1p49;
-  std::vector<Footprint> fps{square(0, 0, lo, "lo"), square(lo, 0, lo, "lo2"), square(hi, hi, 1.0, "hi")};
+  std::vector<Footprint> fps{square(0, 0, lo, "lo"), square(lo, 0, lo, "lo2"), square(hi, hi, 64.0, "hi"),
+                             square(-hi, hi, 1.0, "narrower-than-its-grid")};
   std::vector<Problem> problems;
   const auto plans = build_ground_plans(fps, UnionParams{}, problems);
-  EXPECT_TRUE(problems.empty());
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].source_id, "narrower-than-its-grid");
+  EXPECT_EQ(problems[0].code, "NO_AREA");
+  EXPECT_NE(problems[0].reason.find("narrower than the snap-rounding grid"), std::string::npos) << problems[0].reason;
+  EXPECT_NE(problems[0].reason.find("(2 m,"), std::string::npos) << problems[0].reason;
   ASSERT_EQ(plans.size(), 2u);
   std::size_t lo_plan = plans[0].members.size() == 2 ? 0 : 1;
   EXPECT_EQ(plans[lo_plan].members, (std::vector<std::uint32_t>{0, 1}));
   EXPECT_EQ(plans[lo_plan].polygon.outer.size(), 4u);
+  EXPECT_EQ(plans[lo_plan].area_m2, 2 * lo * lo);
   EXPECT_EQ(plans[1 - lo_plan].members, std::vector<std::uint32_t>{2});
-  EXPECT_EQ(plans[1 - lo_plan].area_m2, 1.0);
+  EXPECT_EQ(plans[1 - lo_plan].area_m2, 4096.0);
 }
 
 TEST(UnionTotalApi, EmptyFootprints) {

@@ -26,12 +26,24 @@ struct GeosComparison {
   std::size_t holes_geos_artifacts = 0;
   /// Our holes proven wrong the same way (triangle holes whose exact centroid an input footprint covers).
   std::size_t holes_ours_covered = 0;
+  /// Where the counts differ or the symmetric difference is over 1e-10 of the area: whether the plans differ
+  /// from GEOS's union only by material narrower than 1.5 snap pitches (`pitch_m` = groundplan::snap_pitch of
+  /// the largest coordinate; gis/geosref/below_pitch.h). Issue 20: vertices closer than the pitch are one
+  /// vertex, so gaps and necks narrower than it close and holes narrower than it collapse, which GEOS's exact
+  /// union keeps, and walls move by up to a pitch along their length.
+  bool differences_checked = false;
+  bool differences_below_pitch = false;
+  double pitch_m = 0;
+  std::string first_difference_not_below_pitch;
   std::size_t invalid_ours = 0;    // plans that GEOSisValid rejects
   std::size_t overlapping_ours = 0;// pairs of our plans whose interiors overlap
   std::string first_invalid_reason;
   /// The DESIGN.md criterion: symdiff <= rel_tol * area, same counts (GEOS's proven artifacts not
-  /// counted, none of ours proven wrong), all valid, no overlaps.
+  /// counted, none of ours proven wrong), all valid, no overlaps. Counts and areas that differ only by
+  /// features narrower than the snap pitch match too (below_pitch).
   bool matches(double rel_tol = 1e-9) const;
+  bool counts_exact() const { return polygons_ours == polygons_geos && holes_ours == holes_geos - holes_geos_artifacts; }
+  bool below_pitch() const { return differences_checked && differences_below_pitch; }
   std::string summary() const;     // one line for a person
 };
 
