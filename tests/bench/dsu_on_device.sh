@@ -6,6 +6,8 @@
 # new libgeos_c.so.1 through LD_LIBRARY_PATH and finds GEOSDisjointSubsetUnion_r at run time.
 # Prints one line per (engine, n) as bench_union does, then the ratios per n. Usage, from the repository root:
 #   tests/bench/dsu_on_device.sh BUNDLE.tar.xz GEOS.tar.xz ["6000 60000 200000"] [DSU_MAX_N]
+# AB_BIN=NAME (a second bench_union packed beside it, e.g. the build before a change): for each n, ROUNDS
+# (default 3) alternated rounds of both on 1 thread and on all cores first, one line each, marked "before".
 set -u
 BUNDLE=${1:?BUNDLE}; GEOS_TAR=${2:?GEOS.tar.xz}; SIZES=${3:-6000 60000 200000 1000000}; DSU_MAX=${4:-1000000}
 OUT=${OUT:-dsu-out}; mkdir -p "$OUT"
@@ -26,7 +28,16 @@ echo "built in $(( $(date +%s) - t0 )) s: $(ls "$W"/geos/lib*/libgeos_c.so.1)"
 GEOSLIB=$(dirname "$(ls "$W"/geos/lib*/libgeos_c.so.1)")
 B() { LD_LIBRARY_PATH=$GEOSLIB:$G/lib timeout 900 "$G/bin/bench_union" "$@" 2>>"$W/stderr.log"; }
 echo "== engine n runs median_wall_s min_wall_s max_wall_s median_cpu_s plans peak_rss_mib input_rss_mib min_cpu_s"
+A() { LD_LIBRARY_PATH=$GEOSLIB:$G/lib timeout 900 "$G/bin/$AB_BIN" "$@" 2>>"$W/stderr.log"; }
 for n in $SIZES; do
+  if [ -n "${AB_BIN:-}" ]; then
+    for r in $(seq "${ROUNDS:-3}"); do
+      echo "$(A --n "$n" --engine ours --threads 1 --runs 3) threads=1 before round=$r"
+      echo "$(B --n "$n" --engine ours --threads 1 --runs 3) threads=1 after round=$r"
+      echo "$(A --n "$n" --engine ours --threads 0 --runs 3) threads=$(nproc) before round=$r"
+      echo "$(B --n "$n" --engine ours --threads 0 --runs 3) threads=$(nproc) after round=$r"
+    done
+  fi
   o1=$(B --n "$n" --engine ours --threads 1 --runs 5); echo "$o1 threads=1"
   on=$(B --n "$n" --engine ours --threads 0 --runs 5); echo "$on threads=$(nproc)"
   d=""; [ "$n" -le "$DSU_MAX" ] && { d=$(B --n "$n" --engine dsu --runs $([ "$n" -le 60000 ] && echo 3 || echo 1)); echo "$d"; }
