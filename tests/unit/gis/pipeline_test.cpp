@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The whole pipeline on real city models, checked against GEOS UnaryUnion through the C API
 // (gis/geosref): same polygons and holes, symmetric difference <= 1e-9 of the area, all valid, and
-// nothing lost (every building read is a footprint or a problem; every footprint is in a plan).
+// nothing lost (every building read is a footprint or a problem; every footprint is in a plan); no
+// near-touching output vertices (tests/support/near_touch.h, issue 20).
 #include <groundplan/error.h>
 #include <groundplan/gis/geos_reference.h>
 #include <groundplan/gis/pipeline.h>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "near_touch.h"
 #include "test_support.h"
 
 namespace groundplan {
@@ -47,6 +49,8 @@ TEST_P(PipelineOnRealData, MatchesGeosAndLosesNothing) {
 
   const gis::GeosComparison cmp = gis::compare_with_geos(r.footprints, r.plans);
   EXPECT_TRUE(cmp.matches(1e-9)) << cmp.summary();
+  const testing::NearTouch nt = testing::near_touch(r.plans, 8, &r.footprints);
+  EXPECT_EQ(nt.pairs, 0u) << nt.first;
 
   // Nothing lost.
   std::size_t building_problems = 0;
@@ -89,6 +93,7 @@ TEST(Pipeline, FolderOfTilesIsOneInput) {
   EXPECT_EQ(r.buildings_read, 408u + 259u - 0u) << "408 Buildings + 259 BuildingParts (SOURCE.txt)";
   const gis::GeosComparison cmp = gis::compare_with_geos(r.footprints, r.plans);
   EXPECT_TRUE(cmp.matches(1e-9)) << cmp.summary();
+  EXPECT_EQ(testing::near_touch(r.plans, 8, &r.footprints).pairs, 0u) << testing::near_touch(r.plans).first;
 }
 
 // A folder: the first file is read alone (it fixes the working CRS), the others side by side, and their footprints
