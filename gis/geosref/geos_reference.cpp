@@ -117,8 +117,7 @@ std::vector<GroundPlan> geos_union(const std::vector<Footprint>& footprints) {
 bool GeosComparison::matches(double rel_tol) const {
   const double scale = std::max(area_geos, area_ours);
   return (symdiff_area <= rel_tol * scale || below_pitch()) && (counts_exact() || below_pitch()) &&
-         holes_ours_covered == 0 &&
-         invalid_ours == 0 && overlapping_ours == 0;
+         holes_ours_covered == 0 && invalid_ours == 0 && overlapping_ours == 0;
 }
 
 std::string GeosComparison::summary() const {
@@ -137,6 +136,20 @@ std::string GeosComparison::summary() const {
       << pitch_m << " m)" << (first_difference_not_below_pitch.empty() ? "" : ": " + first_difference_not_below_pitch);
   if (!first_invalid_reason.empty()) s << "; first invalid: " << first_invalid_reason;
   return s.str();
+}
+
+double snap_pitch_of(const std::vector<Footprint>& footprints) {
+  double m = 0;
+  auto ring = [&](const Ring& r) {
+    for (const Point2& q : r)
+      if (std::isfinite(q.x) && std::isfinite(q.y)) m = std::max({m, std::fabs(q.x), std::fabs(q.y)});
+  };
+  for (const Footprint& f : footprints)
+    for (const Polygon& p : f.polygons) {
+      ring(p.outer);
+      for (const Ring& h : p.holes) ring(h);
+    }
+  return snap_pitch(m);
 }
 
 GeosComparison compare_with_geos(const std::vector<Footprint>& footprints, const std::vector<GroundPlan>& plans,
@@ -232,17 +245,7 @@ GeosComparison compare_with_geos(const std::vector<Footprint>& footprints, const
   const double scale = std::max(c.area_geos, c.area_ours);
   const bool area_off = !(c.symdiff_area <= 1e-10 * scale);
   if (!c.counts_exact() || area_off) {
-    double m = 0;
-    for (const Footprint& f : footprints)
-      for (const Polygon& p : f.polygons) {
-        auto ring = [&](const Ring& r) {
-          for (const Point2& q : r)
-            if (std::isfinite(q.x) && std::isfinite(q.y)) m = std::max({m, std::fabs(q.x), std::fabs(q.y)});
-        };
-        ring(p.outer);
-        for (const Ring& hr : p.holes) ring(hr);
-      }
-    c.pitch_m = snap_pitch(m);
+    c.pitch_m = snap_pitch_of(footprints);
     std::vector<Polygon> ours_p, geos_p;
     for (const GroundPlan& p : plans) ours_p.push_back(p.polygon);
     for (const GEOSGeometry* g : ref_polys) geos_p.push_back(polygon_from(h, g));

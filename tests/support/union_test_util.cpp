@@ -91,19 +91,6 @@ std::string describe(const std::vector<Footprint>& fps) {
   return s.str();
 }
 
-double snap_pitch_of(const std::vector<Footprint>& fps) {
-  double m = 0;
-  for (const Footprint& f : fps)
-    for (const Polygon& p : f.polygons) {
-      for (const Point2& q : p.outer)
-        if (std::isfinite(q.x) && std::isfinite(q.y)) m = std::max({m, std::fabs(q.x), std::fabs(q.y)});
-      for (const Ring& r : p.holes)
-        for (const Point2& q : r)
-          if (std::isfinite(q.x) && std::isfinite(q.y)) m = std::max({m, std::fabs(q.x), std::fabs(q.y)});
-    }
-  return snap_pitch(m);
-}
-
 UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads, double rel_tol, Oracle oracle) {
   UnionCheck c;
   UnionParams params;

@@ -37,9 +37,6 @@ enum class Oracle {
                 // below one ulp, where GEOS's snapping and relate are not exact (see the property test)
 };
 
-/// The engine's snap pitch for these footprints (snap_pitch of their largest coordinate).
-double snap_pitch_of(const std::vector<Footprint>& fps);
-
 /// Runs build_ground_plans (single thread unless threads given) and compares with GEOS UnaryUnion;
 /// also checks our own promises: outer CCW, holes CW, members non-empty. When GEOS's result is not
 /// a fixed point of GEOS's own union (it returned polygons sharing edges), that union is the reference.

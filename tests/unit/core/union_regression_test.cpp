@@ -217,7 +217,7 @@ TEST(UnionRegression, SubPitchHoleOfExactInputVerticesCollapses) {
   EXPECT_EQ(c.plans[0].polygon.holes.size(), 0u);
   EXPECT_EQ(testing::near_touch(c.plans, 8, &fps).pairs, 0u);
   // no vertex moved by more than the pitch (here every hot pixel is an input vertex's)
-  const double g = testing::snap_pitch_of(fps);
+  const double g = gis::snap_pitch_of(fps);
   for (const Point2& p : c.plans[0].polygon.outer) {
     double nearest = INFINITY;
     for (const Footprint& f : fps)

@@ -47,6 +47,10 @@ struct GeosComparison {
   std::string summary() const;     // one line for a person
 };
 
+/// The union's snap pitch for `footprints` (groundplan::snap_pitch of their largest finite coordinate
+/// magnitude): the one compare_with_geos measures differences below.
+double snap_pitch_of(const std::vector<Footprint>& footprints);
+
 /// Compares `plans` with GEOS UnaryUnion of `footprints` (computed here unless `reference` is given).
 GeosComparison compare_with_geos(const std::vector<Footprint>& footprints, const std::vector<GroundPlan>& plans,
                                  const std::vector<GroundPlan>* reference = nullptr);
