@@ -91,7 +91,8 @@ std::string describe(const std::vector<Footprint>& fps) {
   return s.str();
 }
 
-UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads, double rel_tol, Oracle oracle) {
+UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads, double rel_tol, Oracle oracle,
+                           const std::vector<GroundPlan>* reference) {
   UnionCheck c;
   UnionParams params;
   params.threads = threads;
@@ -103,7 +104,7 @@ UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads, doubl
     c.message = std::string("exception: ") + e.what() + "\ninput:\n" + describe(fps);
     return c;
   }
-  std::vector<GroundPlan> ref = gis::geos_union(fps);
+  std::vector<GroundPlan> ref = reference ? *reference : gis::geos_union(fps);
   {
     std::vector<Footprint> again(1);
     for (const GroundPlan& g : ref) again[0].polygons.push_back(g.polygon);

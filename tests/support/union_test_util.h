@@ -40,8 +40,10 @@ enum class Oracle {
 /// Runs build_ground_plans (single thread unless threads given) and compares with GEOS UnaryUnion;
 /// also checks our own promises: outer CCW, holes CW, members non-empty. When GEOS's result is not
 /// a fixed point of GEOS's own union (it returned polygons sharing edges), that union is the reference.
+/// `reference`, when given, is GEOS's union computed elsewhere (of an exact copy of `fps` on a lattice,
+/// brought back to metres: tests/property/self_crossing_property_test.cpp) and is used instead.
 UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads = 1, double rel_tol = 1e-9,
-                           Oracle oracle = Oracle::Strict);
+                           Oracle oracle = Oracle::Strict, const std::vector<GroundPlan>* reference = nullptr);
 
 /// Random points (seeded) where membership in the plans and in the union of the footprints (each
 /// polygon by the even-odd rule) differ: an oracle independent of GEOS. Orientation in long double
