@@ -942,7 +942,7 @@ int run(int argc, char** argv, Ranks* ranks) {
   Ogr2ogrArgs ogr = split_ogr2ogr_args(rest);
 
   PipelineOptions options;
-  options.inputs = {ogr.src};
+  options.inputs = groundplan::gis::input_list(ogr.src);  // a file or folder, or several separated by commas
   options.s_srs = take_source_srs(ogr.options);
   options.union_params.resolution_m = resolution;
   options.union_params.device = groundplan::gis::device_from_string(device);

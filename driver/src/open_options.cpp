@@ -71,11 +71,8 @@ std::vector<std::string> inputs_from_connection(const std::string& connection) {
   const std::size_t n = std::strlen(kPrefix);
   if (connection.size() < n || !EQUALN(connection.c_str(), kPrefix, n))
     throw InvalidArgument("not a GroundPlan connection string (expected GROUNDPLAN:<file or folder>): " + connection);
-  std::vector<std::string> inputs;
-  const CPLStringList parts(CSLTokenizeString2(connection.c_str() + n, ",", CSLT_HONOURSTRINGS));
-  for (int i = 0; i < parts.size(); ++i)
-    if (*parts[i]) inputs.emplace_back(parts[i]);
-  if (inputs.empty()) throw InvalidArgument("GROUNDPLAN: names no input file");
+  std::vector<std::string> inputs = gis::input_list(connection.substr(n));
+  if (inputs.empty() || (inputs.size() == 1 && inputs[0].empty())) throw InvalidArgument("GROUNDPLAN: names no input file");
   return inputs;
 }
 

@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <set>
 #include <unordered_set>
 
 namespace groundplan::gis {
@@ -50,10 +51,39 @@ bool is_ogr_input_name(const std::string& name) {
   return ext == ".shp" || ext == ".gpkg" || ext == ".fgb" || ext == ".geojson";
 }
 
+/// The subfolders of `folder` (at any depth, the first few in name order) that hold input files, for the error
+/// that a folder holds none itself: a folder's own files are its inputs, not its subfolders'.
+std::vector<std::string> subfolders_with_inputs(const std::string& folder) {
+  constexpr std::size_t kNamed = 5, kVisited = 100000;  // a huge tree is not walked whole for a message
+  std::set<std::string> named;
+  std::error_code ec;
+  std::size_t visited = 0;
+  fs::recursive_directory_iterator it(folder, fs::directory_options::skip_permission_denied, ec), end;
+  for (; !ec && it != end && visited < kVisited; it.increment(ec), ++visited) {
+    const std::string name = it->path().filename().string();
+    std::error_code fe;
+    if (it.depth() == 0 || !it->is_regular_file(fe) || !(is_input_name(name) || is_ogr_input_name(name))) continue;
+    named.insert(fs::relative(it->path().parent_path(), folder, fe).generic_string() + "/");
+  }
+  std::vector<std::string> out(named.begin(), named.end());
+  if (out.size() > kNamed) out.resize(kNamed);
+  return out;
+}
+
 /// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF, CityJSON;
 /// not .dae, which belong to a .kml beside them; Shapefile, GeoPackage, FlatGeobuf, GeoJSON) sorted by name,
 /// a .zip as its city files.
 }  // namespace
+
+std::vector<std::string> input_list(const std::string& source) {
+  std::error_code ec;
+  if (source.find(',') == std::string::npos || fs::exists(source, ec)) return {source};
+  std::vector<std::string> inputs;
+  const CPLStringList parts(CSLTokenizeString2(source.c_str(), ",", CSLT_HONOURSTRINGS));
+  for (int i = 0; i < parts.size(); ++i)
+    if (*parts[i]) inputs.emplace_back(parts[i]);
+  return inputs;
+}
 
 std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
   std::vector<std::string> files;
@@ -66,9 +96,17 @@ std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& i
                                     is_ogr_input_name(e.path().filename().string())))
           found.push_back(e.path().string());
       std::sort(found.begin(), found.end());
-      if (found.empty())
-        throw InputError(in + ": folder holds no input file (" + input_name_patterns() +
-                         ", *.shp, *.gpkg, *.fgb, *.geojson)");
+      if (found.empty()) {
+        std::string why = in + ": folder holds no input file (" + input_name_patterns() +
+                          ", *.shp, *.gpkg, *.fgb, *.geojson)";
+        const std::vector<std::string> below = subfolders_with_inputs(in);
+        if (!below.empty()) {
+          why += "; subfolders are not read, and these hold input files:";
+          for (const std::string& b : below) why += " " + b;
+          why += " (name one, or several separated by commas)";
+        }
+        throw InputError(why);
+      }
       files.insert(files.end(), found.begin(), found.end());
     } else if (lower(fs::path(in).extension().string()) == ".zip") {
       // A zip of tiles: its input entries, sorted (read through GDAL's /vsizip/, side by side like a folder).

@@ -284,5 +284,68 @@ TEST(Pipeline, FootprintsMadeInParallelComeOutInReadingOrder) {
   fs::remove(file);
 }
 
+// A folder's own files are its inputs (a zip's entries at any depth are): one that holds none says which of its
+// subfolders hold some (kml-collada-korea-mago/ is such a folder: its KMLs are in sample-kml/ and
+// sample-kml-error-case/), and a folder with none anywhere says only what a folder may hold.
+TEST(Pipeline, FolderWithoutInputFilesNamesTheSubfoldersThatHaveSome) {
+  const test::TempDir dir;
+  dir.file("a/one.gml", "<x/>");
+  dir.file("b/c/two.kml", "<x/>");
+  dir.file("b/c/model.dae", "<x/>");  // a KML's model, not an input
+  dir.file("d/notes.txt", "not an input");
+  dir.file("readme.txt", "not an input");
+  gis::PipelineOptions options;
+  options.inputs = {dir.path.string()};
+  try {
+    (void)gis::run_pipeline(options);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("folder holds no input file"), std::string::npos) << m;
+    EXPECT_NE(m.find("subfolders are not read, and these hold input files: a/ b/c/ (name one"), std::string::npos) << m;
+    EXPECT_EQ(m.find("d/"), std::string::npos) << m;
+  }
+  std::filesystem::remove_all(dir.path / "a");
+  std::filesystem::remove_all(dir.path / "b");
+  try {
+    (void)gis::run_pipeline(options);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("folder holds no input file"), std::string::npos) << m;
+    EXPECT_EQ(m.find("subfolders"), std::string::npos) << m;
+  }
+}
+
+// The CLI's source and what follows GROUNDPLAN: name one input or several separated by commas; a path that
+// exists as written is one input, commas and all.
+TEST(Pipeline, InputListSplitsAtCommasUnlessThePathExists) {
+  EXPECT_EQ(gis::input_list("tiles/a.gml"), (std::vector<std::string>{"tiles/a.gml"}));
+  EXPECT_EQ(gis::input_list("a.gml,b/,,c.kmz"), (std::vector<std::string>{"a.gml", "b/", "c.kmz"}));
+  EXPECT_EQ(gis::input_list("\"x,1.gml\",y.gml"), (std::vector<std::string>{"x,1.gml", "y.gml"}));
+  const test::TempDir dir;
+  const std::string odd = dir.file("tile,1.gml", "<x/>");
+  EXPECT_EQ(gis::input_list(odd), (std::vector<std::string>{odd}));
+  // Two folders by commas read as one input: the Niedersachsen tiles split in two folders give all 4 tiles' plans.
+  const std::filesystem::path tiles = test::shared_data("citygml1-niedersachsen-lod1-4tiles");
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(tiles))
+    if (e.path().extension() == ".gml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 4u);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::filesystem::path to = dir.path / (i < 2 ? "first" : "second") / files[i].filename();
+    std::filesystem::create_directories(to.parent_path());
+    std::filesystem::copy_file(files[i], to);
+  }
+  gis::PipelineOptions split, whole;
+  split.inputs = gis::input_list((dir.path / "first").string() + "," + (dir.path / "second").string());
+  whole.inputs = {tiles.string()};
+  const gis::PipelineResult a = gis::run_pipeline(split), b = gis::run_pipeline(whole);
+  EXPECT_EQ(a.buildings_read, b.buildings_read);
+  EXPECT_EQ(test::plan_keys(a.plans), test::plan_keys(b.plans));
+  EXPECT_FALSE(a.plans.empty());
+}
+
 }  // namespace
 }  // namespace groundplan

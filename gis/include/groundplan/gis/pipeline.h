@@ -90,6 +90,11 @@ struct PipelineResult {
 /// when `progress` asks to stop. A bad building is a Problem, not an exception.
 PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
 
+/// The inputs a source names as users write it, in the CLI and after `GROUNDPLAN:`: one file or folder, or
+/// several separated by commas (a path that exists as written is one input, commas and all; double quotes keep
+/// a comma inside one name). Empty names are left out.
+std::vector<std::string> input_list(const std::string& source);
+
 /// CPU time of this process so far, all threads (getrusage), in seconds: set beside a wall time, it shows
 /// idle or spinning cores (--stats "timings_s"."cpu").
 double process_cpu_seconds();
