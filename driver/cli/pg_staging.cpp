@@ -12,16 +12,17 @@
 #include <ctime>
 
 namespace groundplan::cli {
+
+std::string gdal_error(const std::string& fallback) {
+  const char* m = CPLGetLastErrorMsg();
+  return m && *m ? std::string(m) : fallback;
+}
+
 namespace {
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
-}
-
-std::string gdal_error(const std::string& fallback) {
-  const char* m = CPLGetLastErrorMsg();
-  return m && *m ? std::string(m) : fallback;
 }
 
 /// `text` as an SQL string literal.

@@ -15,6 +15,9 @@
 
 namespace groundplan::cli {
 
+/// GDAL's last error message, or `fallback` when there is none (also used by rank_writes.cpp).
+std::string gdal_error(const std::string& fallback);
+
 /// Why the run's tables are written in place, in the user's schema (empty: they can be staged). Staging needs the
 /// schema asked for to be the connection's current one, named by nothing but the connection itself (not by
 /// active_schema= or schemas= in it, -lco SCHEMA= or a dotted -nln), a "key=value" connection string (active_schema is

@@ -29,12 +29,6 @@ std::string failures(const std::vector<std::string>& texts) {
   return out;
 }
 
-/// GDAL's last error message, or `fallback`.
-std::string gdal_error(const std::string& fallback) {
-  const char* m = CPLGetLastErrorMsg();
-  return m && *m ? std::string(m) : fallback;
-}
-
 /// GDAL's ogr2ogr from `src` into `dst` (a name, or an open dataset `dst_ds` to add to); empty or why it failed.
 std::string translate(const std::string& dst, GDALDatasetH dst_ds, GDALDataset* src, const std::vector<std::string>& args) {
   CPLStringList argv;
