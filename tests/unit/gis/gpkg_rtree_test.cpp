@@ -139,6 +139,20 @@ TEST(GpkgRtree, PackedIndexHoldsEveryNonEmptyBoxRoundedOutwards) {
   EXPECT_EQ(query(path, "SELECT count(*) FROM gpkg_extensions WHERE extension_name = 'gpkg_rtree_index'")[0][0], 1.0);
 }
 
+// The index rows go in by INSERTs of 256 rows (gpkg_rtree.cpp, PairInserter): whole batches only, and one row.
+TEST(GpkgRtree, EntriesInWholeBatchesAndASingleOne) {
+  GDALAllRegister();
+  for (int n : {1, 256, 512}) {
+    test::TempDir dir("gpkg_rtree");
+    const std::string path = (dir.path / "parts.gpkg").string();
+    const std::vector<Box> boxes = write_gpkg(path, n);
+    const cli::RtreeBuild built = cli::build_gpkg_rtrees(path, 2);
+    ASSERT_EQ(built.error, "") << n;
+    EXPECT_EQ(built.entries, boxes.size()) << n;
+    expect_index_holds(path, boxes);
+  }
+}
+
 TEST(GpkgRtree, GdalsOwnWayGivesTheSameEntries) {
   GDALAllRegister();
   test::TempDir dir("gpkg_rtree");
