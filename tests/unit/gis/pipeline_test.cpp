@@ -287,6 +287,17 @@ TEST(Pipeline, FootprintsMadeInParallelComeOutInReadingOrder) {
 // A folder's own files are its inputs (a zip's entries at any depth are): one that holds none says which of its
 // subfolders hold some (kml-collada-korea-mago/ is such a folder: its KMLs are in sample-kml/ and
 // sample-kml-error-case/), and a folder with none anywhere says only what a folder may hold.
+/// The message of the InputError that run_pipeline throws on `options` (a failure when none is thrown).
+std::string input_error(const gis::PipelineOptions& options) {
+  try {
+    (void)gis::run_pipeline(options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return "";
+}
+
 TEST(Pipeline, FolderWithoutInputFilesNamesTheSubfoldersThatHaveSome) {
   const test::TempDir dir;
   dir.file("a/one.gml", "<x/>");
@@ -296,25 +307,15 @@ TEST(Pipeline, FolderWithoutInputFilesNamesTheSubfoldersThatHaveSome) {
   dir.file("readme.txt", "not an input");
   gis::PipelineOptions options;
   options.inputs = {dir.path.string()};
-  try {
-    (void)gis::run_pipeline(options);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find("folder holds no input file"), std::string::npos) << m;
-    EXPECT_NE(m.find("subfolders are not read, and these hold input files: a/ b/c/ (name one"), std::string::npos) << m;
-    EXPECT_EQ(m.find("d/"), std::string::npos) << m;
-  }
+  std::string m = input_error(options);
+  EXPECT_NE(m.find("folder holds no input file"), std::string::npos) << m;
+  EXPECT_NE(m.find("subfolders are not read, and these hold input files: a/ b/c/ (name one"), std::string::npos) << m;
+  EXPECT_EQ(m.find("d/"), std::string::npos) << m;
   std::filesystem::remove_all(dir.path / "a");
   std::filesystem::remove_all(dir.path / "b");
-  try {
-    (void)gis::run_pipeline(options);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find("folder holds no input file"), std::string::npos) << m;
-    EXPECT_EQ(m.find("subfolders"), std::string::npos) << m;
-  }
+  m = input_error(options);
+  EXPECT_NE(m.find("folder holds no input file"), std::string::npos) << m;
+  EXPECT_EQ(m.find("subfolders"), std::string::npos) << m;
 }
 
 // The CLI's source and what follows GROUNDPLAN: name one input or several separated by commas; a path that
