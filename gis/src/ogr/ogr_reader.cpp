@@ -284,6 +284,15 @@ bool ogr_can_read(const std::string& path) {
 
 namespace ogr_detail {
 
+namespace {
+LayerPlan layer_plan(OGRLayer* layer, std::string name) {
+  LayerPlan p;
+  p.layer = layer;
+  p.name = std::move(name);
+  return p;
+}
+}  // namespace
+
 ErrorCollector::ErrorCollector() { CPLPushErrorHandlerEx(&ErrorCollector::handler, this); }
 ErrorCollector::~ErrorCollector() { CPLPopErrorHandler(); }
 
@@ -337,7 +346,7 @@ void open_source(const std::string& path, const OgrInputOptions& options, Source
       const std::string why = errors.take();
       throw InputError(path + ": --input-sql gave no layer" + (why.empty() ? "" : " (" + why + ")") + ": " + options.sql);
     }
-    plans.push_back(LayerPlan{src.sql_layer, src.sql_layer->GetName()});
+    plans.push_back(layer_plan(src.sql_layer, src.sql_layer->GetName()));
   } else if (!options.layers.empty()) {
     for (const std::string& name : options.layers) {
       OGRLayer* l = ds->GetLayerByName(name.c_str());
@@ -346,10 +355,10 @@ void open_source(const std::string& path, const OgrInputOptions& options, Source
         for (int i = 0; i < ds->GetLayerCount() && i < 40; ++i) names += (i ? ", " : "") + std::string(ds->GetLayer(i)->GetName());
         throw InputError(path + ": has no layer '" + name + "' (--input-layer); its layers: " + (names.empty() ? "none" : names));
       }
-      plans.push_back(LayerPlan{l, name});
+      plans.push_back(layer_plan(l, name));
     }
   } else {
-    for (int i = 0; i < ds->GetLayerCount(); ++i) plans.push_back(LayerPlan{ds->GetLayer(i), ds->GetLayer(i)->GetName()});
+    for (int i = 0; i < ds->GetLayerCount(); ++i) plans.push_back(layer_plan(ds->GetLayer(i), ds->GetLayer(i)->GetName()));
   }
   if (plans.empty()) throw InputError(path + ": GDAL (" + info.driver + ") opens it, but it has no vector layer");
 

@@ -53,7 +53,9 @@ TEST(BelowPitchCheck, AHoleNarrowerThanThePitchCollapsed) {
     const gis::GeosComparison c = gis::compare_with_geos(fps, ours);
     ASSERT_EQ(c.holes_geos, 1u) << c.summary();
     EXPECT_EQ(c.matches(1e-9), h == kBelow) << c.summary();
-    if (h == kWide) EXPECT_NE(c.first_difference_not_below_pitch.find("near (5 5"), std::string::npos) << c.summary();
+    if (h == kWide) {
+      EXPECT_NE(c.first_difference_not_below_pitch.find("near (5 5"), std::string::npos) << c.summary();
+    }
   }
 }
 

@@ -113,7 +113,9 @@ TEST(RobustPredicates, TieOfCrossingsOnOneLineIsCertifiedWithoutMpfr) {
   EXPECT_EQ(compare_crossings(a, b, f0, f1, f0, f1), 0);
   EXPECT_EQ(compare_crossings(a, b, f0, f1, f1, f0), 0);
   const Point2 mid{(f0.x + f1.x) / 2, (f0.y + f1.y) / 2};
-  if (orient(f0, f1, mid) == 0) EXPECT_EQ(compare_crossings(a, b, f0, f1, mid, f1), 0);
+  if (orient(f0, f1, mid) == 0) {
+    EXPECT_EQ(compare_crossings(a, b, f0, f1, mid, f1), 0);
+  }
   const RungStats s = rung_stats();
   EXPECT_EQ(s.at(Family::CompareCrossings, 2), 0u);
   EXPECT_GE(s.at(Family::CompareCrossings, 1), 2u);

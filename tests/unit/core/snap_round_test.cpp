@@ -202,7 +202,6 @@ TEST(SnapRound, ExactGroupNextToASnappedGroupStaysBitExact) {
   const auto plans = build_ground_plans(fps, UnionParams{}, problems);
   EXPECT_TRUE(problems.empty());
   ASSERT_EQ(plans.size(), 2u);
-  const double g = detail::snap_pitch(5400030.7);
   int exact = 0, snapped = 0;
   for (const GroundPlan& p : plans) {
     if (p.polygon.holes.size() == 1) {
