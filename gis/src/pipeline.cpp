@@ -70,9 +70,6 @@ std::vector<std::string> subfolders_with_inputs(const std::string& folder) {
   return out;
 }
 
-/// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF, CityJSON;
-/// not .dae, which belong to a .kml beside them; Shapefile, GeoPackage, FlatGeobuf, GeoJSON) sorted by name,
-/// a .zip as its city files.
 }  // namespace
 
 std::vector<std::string> input_list(const std::string& source) {
@@ -85,6 +82,9 @@ std::vector<std::string> input_list(const std::string& source) {
   return inputs;
 }
 
+/// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF, CityJSON;
+/// not .dae, which belong to a .kml beside them; Shapefile, GeoPackage, FlatGeobuf, GeoJSON) sorted by name,
+/// a .zip as its city files.
 std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& inputs, std::vector<Problem>& problems) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
