@@ -93,17 +93,27 @@ std::string describe(const std::vector<Footprint>& fps) {
 
 UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads, double rel_tol, Oracle oracle,
                            const std::vector<GroundPlan>* reference) {
-  UnionCheck c;
   UnionParams params;
   params.threads = threads;
-  std::ostringstream msg;
+  std::vector<GroundPlan> plans;
+  std::vector<Problem> problems;
   try {
-    c.plans = build_ground_plans(fps, params, c.problems);
+    plans = build_ground_plans(fps, params, problems);
   } catch (const std::exception& e) {
+    UnionCheck c;
     c.ok = false;
     c.message = std::string("exception: ") + e.what() + "\ninput:\n" + describe(fps);
     return c;
   }
+  return compare_union(fps, std::move(plans), std::move(problems), rel_tol, oracle, reference);
+}
+
+UnionCheck compare_union(const std::vector<Footprint>& fps, std::vector<GroundPlan> plans, std::vector<Problem> problems,
+                         double rel_tol, Oracle oracle, const std::vector<GroundPlan>* reference) {
+  UnionCheck c;
+  c.plans = std::move(plans);
+  c.problems = std::move(problems);
+  std::ostringstream msg;
   std::vector<GroundPlan> ref = reference ? *reference : gis::geos_union(fps);
   {
     std::vector<Footprint> again(1);

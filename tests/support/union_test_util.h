@@ -45,6 +45,11 @@ enum class Oracle {
 UnionCheck run_and_compare(const std::vector<Footprint>& fps, int threads = 1, double rel_tol = 1e-9,
                            Oracle oracle = Oracle::Strict, const std::vector<GroundPlan>* reference = nullptr);
 
+/// run_and_compare's checks of plans already computed (`plans`, `problems`: build_ground_plans's answer for `fps`).
+UnionCheck compare_union(const std::vector<Footprint>& fps, std::vector<GroundPlan> plans, std::vector<Problem> problems,
+                         double rel_tol = 1e-9, Oracle oracle = Oracle::Strict,
+                         const std::vector<GroundPlan>* reference = nullptr);
+
 /// Random points (seeded) where membership in the plans and in the union of the footprints (each
 /// polygon by the even-odd rule) differ: an oracle independent of GEOS. Orientation in long double
 /// on random points (a point exactly on a boundary has probability zero).
