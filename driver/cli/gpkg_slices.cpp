@@ -65,48 +65,58 @@ void append_part(const sqlite::Db& db, const std::string& part, const std::strin
 
 }  // namespace
 
-void append_runs(const std::string& dst, const std::vector<AppendRun>& runs) {
+Appender::Appender(const std::string& dst, const std::vector<std::string>& tables) : db_(dst), tables_(tables) {
+  using sqlite::lit;
+  for (const std::string& table : tables_) {
+    sqlite::Stmt s(db_, "SELECT name, sql FROM sqlite_master WHERE type = 'trigger' AND lower(tbl_name) = lower(" +
+                            lit(table) + ")");
+    while (s.row()) triggers_.push_back({s.text(0), s.text(1)});
+  }
+  {
+    sqlite::Stmt s(db_, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'gpkg_ogr_contents'");
+    has_ogr_contents_ = s.row();
+  }
+  // The file is only handed over after the last commit, which syncs it; the appends need not each.
+  db_.exec("PRAGMA synchronous = OFF");
+  for (const auto& t : triggers_) db_.exec("DROP TRIGGER " + sqlite::id(t[0]));
+}
+
+void Appender::append(const AppendRun& run) {
+  if (std::find(tables_.begin(), tables_.end(), run.table) == tables_.end())
+    throw sqlite::Failure(run.table + ": not a table this appender was opened for");
+  db_.exec("ATTACH DATABASE " + sqlite::lit(run.part) + " AS part");
+  try {
+    db_.exec("BEGIN");
+    append_part(db_, run.part, run.table, run.first, run.last);
+    db_.exec("COMMIT");
+  } catch (...) {
+    db_.exec("ROLLBACK");
+    db_.exec("DETACH DATABASE part");
+    throw;
+  }
+  db_.exec("DETACH DATABASE part");
+}
+
+void Appender::finish() {
   using sqlite::id;
   using sqlite::lit;
-  sqlite::Db db(dst);
+  db_.exec("PRAGMA synchronous = FULL");
+  db_.exec("BEGIN");
+  if (has_ogr_contents_)
+    for (const std::string& table : tables_)
+      db_.exec("UPDATE gpkg_ogr_contents SET feature_count = (SELECT count(*) FROM " + id(table) +
+               ") WHERE lower(table_name) = lower(" + lit(table) + ")");
+  for (const auto& t : triggers_) db_.exec(t[1]);
+  db_.exec("COMMIT");
+}
+
+void append_runs(const std::string& dst, const std::vector<AppendRun>& runs) {
   std::vector<std::string> tables;
   for (const AppendRun& r : runs)
     if (std::find(tables.begin(), tables.end(), r.table) == tables.end()) tables.push_back(r.table);
-  std::vector<std::array<std::string, 2>> triggers;
-  for (const std::string& table : tables) {
-    sqlite::Stmt s(db, "SELECT name, sql FROM sqlite_master WHERE type = 'trigger' AND lower(tbl_name) = lower(" +
-                           lit(table) + ")");
-    while (s.row()) triggers.push_back({s.text(0), s.text(1)});
-  }
-  bool has_ogr_contents = false;
-  {
-    sqlite::Stmt s(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'gpkg_ogr_contents'");
-    has_ogr_contents = s.row();
-  }
-  // The file is only handed over after the last commit, which syncs it; the appends need not each.
-  db.exec("PRAGMA synchronous = OFF");
-  for (const auto& t : triggers) db.exec("DROP TRIGGER " + id(t[0]));
-  for (const AppendRun& run : runs) {
-    db.exec("ATTACH DATABASE " + lit(run.part) + " AS part");
-    try {
-      db.exec("BEGIN");
-      append_part(db, run.part, run.table, run.first, run.last);
-      db.exec("COMMIT");
-    } catch (...) {
-      db.exec("ROLLBACK");
-      db.exec("DETACH DATABASE part");
-      throw;
-    }
-    db.exec("DETACH DATABASE part");
-  }
-  db.exec("PRAGMA synchronous = FULL");
-  db.exec("BEGIN");
-  if (has_ogr_contents)
-    for (const std::string& table : tables)
-      db.exec("UPDATE gpkg_ogr_contents SET feature_count = (SELECT count(*) FROM " + id(table) +
-              ") WHERE lower(table_name) = lower(" + lit(table) + ")");
-  for (const auto& t : triggers) db.exec(t[1]);
-  db.exec("COMMIT");
+  Appender appender(dst, tables);
+  for (const AppendRun& run : runs) appender.append(run);
+  appender.finish();
 }
 
 void remove_with_sidecars(const std::string& path) {
@@ -156,13 +166,17 @@ int gpkg_writers(const std::vector<std::string>& flags, const std::vector<std::s
   return writers;
 }
 
-std::vector<std::string> slice_paths(const std::string& dst, int writers, const std::string& ext) {
+std::string slice_path(const std::string& dst, std::size_t k, const std::string& ext) {
+  if (k == 0) return dst;
   const std::filesystem::path d(dst);
-  std::vector<std::string> paths = {dst};
-  for (int k = 1; k < writers; ++k)
-    paths.push_back((d.parent_path() / ("." + d.stem().string() + ".slice" + std::to_string(k) + "-" +
-                                        std::to_string(::getpid()) + ext))
-                        .string());
+  return (d.parent_path() / ("." + d.stem().string() + ".slice" + std::to_string(k) + "-" + std::to_string(::getpid()) +
+                             ext))
+      .string();
+}
+
+std::vector<std::string> slice_paths(const std::string& dst, int writers, const std::string& ext) {
+  std::vector<std::string> paths;
+  for (int k = 0; k < std::max(1, writers); ++k) paths.push_back(slice_path(dst, static_cast<std::size_t>(k), ext));
   return paths;
 }
 

@@ -11,9 +11,12 @@
 // table's extent and feature count are set for all of them. What a reader gets is what one writer gives:
 // the same tables, schema, rows, FIDs (1..N in plan order), extent and count; only the file's page layout
 // differs. The spatial index is packed afterwards as for any new GeoPackage (gpkg_rtree.h).
+#include "sqlite_db.h"
+
 #include <gdal.h>
 
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -50,6 +53,21 @@ struct AppendRun {
   std::string part;   // the slice file
   std::string table;  // the same table in both files
   std::int64_t first = 0, last = -1;
+};
+
+/// append_runs one run at a time, for a writer that appends each slice as soon as it is written (streamed_gpkg.h):
+/// opening takes the tables' triggers off, finish() sets the feature counts and puts the triggers back.
+class Appender {
+ public:
+  Appender(const std::string& dst, const std::vector<std::string>& tables);
+  void append(const AppendRun& run);  // one transaction; `run.table` must be one of `tables`
+  void finish();
+
+ private:
+  sqlite::Db db_;
+  std::vector<std::string> tables_;
+  std::vector<std::array<std::string, 2>> triggers_;  // name, sql
+  bool has_ogr_contents_ = false;
 };
 
 /// Appends the runs to the GeoPackage `dst` in the order given, one transaction each (SQLite copies the records;
@@ -92,6 +110,10 @@ SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, c
 bool write_slices_side_by_side(const SliceWrite& w, const SliceSource& source, const Translate& translate,
                                const std::vector<std::string>& paths, const std::vector<std::string>& extra,
                                SliceOutcome& out);
+
+/// Where slice k of a new `dst` is written: dst itself for k = 0, the others hidden beside it
+/// (".<stem>.slice<k>-<pid><ext>").
+std::string slice_path(const std::string& dst, std::size_t k, const std::string& ext);
 
 /// Where the `writers` slices of a new `dst` are written: dst itself for slice 0, the others hidden beside it
 /// (".<stem>.slice<k>-<pid><ext>").

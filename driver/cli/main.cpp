@@ -13,6 +13,7 @@
 #include "mpi_exchange.h"
 #include "rank_writes.h"
 #include "staged_output.h"
+#include "streamed_gpkg.h"
 #endif
 
 #include <groundplan/error.h>
@@ -355,16 +356,42 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
 }
 
 
+/// The writer of a new GeoPackage that starts while the union goes on (streamed_gpkg.h), or null where the plans are
+/// written after the union: not a new GeoPackage whose index the CLI packs, an ogr2ogr option that rules slices out
+/// (gpkg_slices.h), a level of detail (its steps change the union's plans), one thread, or
+/// `--config GROUNDPLAN_WRITE_DURING_UNION NO`. Whether it is used is known once the union has begun (enough plans).
+std::unique_ptr<groundplan::cli::StreamedGpkg> stream_plans(const Ogr2ogrArgs& ogr, const PipelineOptions& options,
+                                                            std::size_t id_chars) {
+  if (!CPLTestBool(CPLGetConfigOption("GROUNDPLAN_WRITE_DURING_UNION", "YES"))) return nullptr;
+  if (!packs_gpkg_index(ogr) || options.detail.any()) return nullptr;
+  const int threads = static_cast<int>(groundplan::gis::thread_count(options.threads));
+  if (threads < 2) return nullptr;
+  groundplan::cli::StreamedGpkg::Setup setup;
+  setup.write.dst = ogr.dst;
+  // As write_output: ogr2ogr's options without the layer names, the index packed afterwards.
+  setup.write.flags.assign(ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size()));
+  setup.write.flags.insert(setup.write.flags.end(), {"-lco", "SPATIAL_INDEX=NO"});
+  setup.write.layers = ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+  if (!groundplan::cli::slices_ruled_out(setup.write.flags, setup.write.layers, "ground_plans").empty()) return nullptr;
+  setup.write.progress = ogr.progress && !ogr.quiet;
+  setup.threads = threads;
+  setup.id_chars = id_chars;
+  setup.translate = vector_translate;
+  return std::make_unique<groundplan::cli::StreamedGpkg>(std::move(setup));
+}
+
 /// Writes our dataset (taking it: closed here) through GDAL's ogr2ogr with the user's options, packs a new
 /// GeoPackage's spatial index, and writes the full member lists beside a DBF whose id lists were cut.
 /// `another`, where given, makes one more dataset like `ds` (the one-process result): a new GeoPackage is then
 /// written by several writers side by side (gpkg_slices.h).
 WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads,
-                          const std::function<groundplan::driver::OGRGroundPlanDataSource*(int threads)>& another = {}) {
+                          const std::function<groundplan::driver::OGRGroundPlanDataSource*(int threads)>& another = {},
+                          groundplan::cli::StreamedGpkg* streamed = nullptr) {
   WriteOutcome w;
   const bool dbf = writes_dbf(ogr);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
-  const bool own_index = packs_gpkg_index(ogr);
+  // Streamed, the destination exists by now: it is the new GeoPackage the index is packed for.
+  const bool own_index = (streamed && streamed->engaged()) || packs_gpkg_index(ogr);
   w.own_index = own_index;
   // ogr2ogr's options without the layer names (they come last), then the layers.
   std::vector<std::string> flags(ogr.options.begin(),
@@ -383,7 +410,29 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
   std::error_code exists_ec;
   const bool csv = !own_index && groundplan::cli::is_csv_file(ogr.format, ogr.dst) &&
                    !std::filesystem::exists(ogr.dst, exists_ec);
-  if ((own_index || csv) && another) {
+  if (streamed && streamed->engaged() && another) {
+    // The slices were written while the union went on (streamed_gpkg.h): slice 0 where it carries other layers,
+    // then what is left of the writing and appending.
+    writers = 0;
+    const groundplan::cli::SliceSource slice0 = [&](std::size_t first, std::size_t last) -> GDALDatasetH {
+      auto* d = another(std::max(1, n_threads / streamed->writers()));
+      if (!d || !d->layer("ground_plans")) {
+        delete d;
+        return nullptr;
+      }
+      d->layer("ground_plans")->restrict_to(first, last);
+      return GDALDataset::ToHandle(d);
+    };
+    const auto out = streamed->finish(slice0);
+    write_ok = out.ok;
+    if (!out.ok) std::fprintf(stderr, "groundplan: %s\n", out.error.c_str());
+    w.writer = {{"writers", streamed->writers()},
+                {"during_union", true},
+                {"slices", streamed->slices()},
+                {"slices_started_during_union", streamed->slices_before_end()},
+                {"slices_s", out.slices_s},
+                {"after_union_s", out.merge_s}};
+  } else if ((own_index || csv) && another) {
     auto* plans_layer = ds->layer("ground_plans");
     const std::size_t plans = plans_layer ? static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE)) : 0;
     writers = csv ? groundplan::cli::csv_writers(flags, layers, "ground_plans", plans, n_threads, &why_one)
@@ -1001,6 +1050,11 @@ int run(int argc, char** argv, Ranks* ranks) {
     progress = groundplan::Progress([](double f, const char* msg) {
       return GDALTermProgress(f, msg, nullptr) != FALSE;
     });
+  // A new GeoPackage of many plans is written while the union goes on (streamed_gpkg.h).
+  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
+  std::unique_ptr<groundplan::cli::StreamedGpkg> streamed = stream_plans(ogr, options, id_chars);
+  if (streamed)
+    options.plan_feed = [&streamed](const PipelineResult& read) { return streamed->engage(read); };
   const auto result_ptr = std::make_shared<const PipelineResult>(groundplan::gis::run_pipeline(options, progress.sub(0, 1)));
   const PipelineResult& result = *result_ptr;
 
@@ -1020,11 +1074,10 @@ int run(int argc, char** argv, Ranks* ranks) {
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
   const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
-  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, options.threads);
   const WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
     return new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, threads);
-  });
+  }, streamed.get());
   const bool write_ok = w.ok;
   const double write_s = w.write_s, index_s = w.index_s;
   const std::string& members_note = w.members_note;

@@ -75,6 +75,48 @@ std::unique_ptr<OGRGroundPlanLayer> detail::problems_layer(const std::vector<Pro
   return layer;
 }
 
+std::unique_ptr<OGRGroundPlanLayer> detail::plans_layer(const OGRSpatialReference* srs, std::size_t count,
+                                                       PlanAt plan_at, const Footprint* fps, std::size_t n_fps,
+                                                       std::size_t max_id_list_chars, std::function<OGREnvelope()> extent,
+                                                       int threads) {
+  auto layer = std::make_unique<OGRGroundPlanLayer>(
+      "ground_plans", wkbPolygon, srs, count,
+      [plan_at = std::move(plan_at), fps, n_fps, max_id_list_chars](OGRFeatureDefn* defn, std::size_t i) {
+        const GroundPlan& gp = plan_at(i);
+        auto* f = new OGRFeature(defn);
+        std::string ids;
+        double zmin = 0, zmax = 0;
+        bool first = true;
+        for (std::uint32_t m : gp.members) {
+          if (m >= n_fps) continue;
+          if (!ids.empty()) ids += ',';
+          ids += fps[m].source_id;
+          zmin = first ? fps[m].min_z : std::min(zmin, fps[m].min_z);
+          zmax = first ? fps[m].max_z : std::max(zmax, fps[m].max_z);
+          first = false;
+        }
+        f->SetField(0, static_cast<GIntBig>(i + 1));
+        f->SetField(1, static_cast<int>(gp.members.size()));
+        f->SetField(2, gp.area_m2);
+        if (!first) {
+          f->SetField(3, zmin);
+          f->SetField(4, zmax);
+        }
+        f->SetField(5, cut_id_list(ids, gp.members.size(), max_id_list_chars).c_str());
+        f->SetGeometryDirectly(to_ogr_polygon(gp.polygon));
+        return f;
+      },
+      std::move(extent), threads);
+  // DBF field names hold 10 characters: say what GDAL would otherwise launder with a warning.
+  add_field(layer->defn(), "gp_id", OFTInteger64);
+  add_field(layer->defn(), "n_parts", OFTInteger);
+  add_field(layer->defn(), "area_m2", OFTReal);
+  add_field(layer->defn(), "min_z", OFTReal);
+  add_field(layer->defn(), "max_z", OFTReal);
+  add_field(layer->defn(), max_id_list_chars > 0 ? "bldg_ids" : "building_ids", OFTString);
+  return layer;
+}
+
 namespace {
 
 /// The envelope of `rings` (outer rings of plans or footprint polygons).
@@ -123,48 +165,16 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   const GIntBig* plan_of = plan_of_.data();
 
   // DBF field names hold 10 characters: say what GDAL would otherwise launder with a warning.
-  const char* ids_field = dbf ? "bldg_ids" : "building_ids";
   const char* file_field = dbf ? "src_file" : "source_file";
-  auto plans = std::make_unique<OGRGroundPlanLayer>(
-      "ground_plans", wkbPolygon, srs, r.plans.size(),
-      [res, max_id_list_chars](OGRFeatureDefn* defn, std::size_t i) {
-        const GroundPlan& gp = res->plans[i];
-        const auto& fps = res->footprints;
-        auto* f = new OGRFeature(defn);
-        std::string ids;
-        double zmin = 0, zmax = 0;
-        bool first = true;
-        for (std::uint32_t m : gp.members) {
-          if (m >= fps.size()) continue;
-          if (!ids.empty()) ids += ',';
-          ids += fps[m].source_id;
-          zmin = first ? fps[m].min_z : std::min(zmin, fps[m].min_z);
-          zmax = first ? fps[m].max_z : std::max(zmax, fps[m].max_z);
-          first = false;
-        }
-        f->SetField(0, static_cast<GIntBig>(i + 1));
-        f->SetField(1, static_cast<int>(gp.members.size()));
-        f->SetField(2, gp.area_m2);
-        if (!first) {
-          f->SetField(3, zmin);
-          f->SetField(4, zmax);
-        }
-        f->SetField(5, cut_id_list(ids, gp.members.size(), max_id_list_chars).c_str());
-        f->SetGeometryDirectly(to_ogr_polygon(gp.polygon));
-        return f;
-      },
+  auto plans = detail::plans_layer(
+      srs, r.plans.size(), [res](std::size_t i) -> const GroundPlan& { return res->plans[i]; }, fps.data(), fps.size(),
+      max_id_list_chars,
       [res] {
         return envelope_of([&](auto&& ring) {
           for (const GroundPlan& gp : res->plans) ring(gp.polygon.outer);
         });
       },
       threads);
-  add_field(plans->defn(), "gp_id", OFTInteger64);
-  add_field(plans->defn(), "n_parts", OFTInteger);
-  add_field(plans->defn(), "area_m2", OFTReal);
-  add_field(plans->defn(), "min_z", OFTReal);
-  add_field(plans->defn(), "max_z", OFTReal);
-  add_field(plans->defn(), ids_field, OFTString);
 
   auto footprints = std::make_unique<OGRGroundPlanLayer>(
       "footprints", wkbMultiPolygon, srs, fps.size(),

@@ -336,6 +336,7 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   UnionStats union_stats;
   UnionParams union_params = options.union_params;
   union_params.stats = &union_stats;
+  if (options.plan_feed && !options.detail.any()) union_params.feed = options.plan_feed(result);
   result.plans = build_ground_plans(result.footprints, union_params, options.detail, result.problems,
                                     progress.sub(0.6, 1.0), &result.lod_stats);
   result.blocks = union_stats.blocks;

@@ -5,12 +5,13 @@
 # and with --threads 1, reading scaling over 1..16 threads, the GeoPackage writer against ogr2ogr copying
 # the same features, CPU time and peak RSS (/usr/bin/time), and the outputs' hashes (the same whatever
 # the threads or the cut). Usage, from the repository root:
-#   [SECTIONS="same e2e index alloc copy scaling xml bench"] tests/bench/city_scale_on_device.sh BUNDLE.tar.xz [CITY_MB] [BIG_CITY_MB]
+#   [SECTIONS="same e2e index alloc copy scaling xml bench ab stream"] tests/bench/city_scale_on_device.sh BUNDLE.tar.xz [CITY_MB] [BIG_CITY_MB]
 # SECTIONS picks what runs (default: all but xml and bench); "xml" times the CityGML reader in memory (pugixml,
 # the default) against streamed through expat (--config GROUNDPLAN_XML_IN_MEMORY_BYTES 0) in alternated rounds,
 # "bench" runs citygml_read_bench (packed with PACK_EXTRA_BINS) on two real samples and a 60 MB generated city;
 # "ab" alternates this build with another CLI packed beside it (AB_BIN=groundplan_before, a path given to
-# PACK_EXTRA_BINS) on the same inputs, and compares their outputs.
+# PACK_EXTRA_BINS) on the same inputs, and compares their outputs; "stream" alternates the GeoPackage written while
+# the union goes on with the same build writing after it, and compares the files' tables.
 set -u
 BUNDLE=${1:?BUNDLE}; MB=${2:-1500}; BIG_MB=${3:-0}
 SECTIONS=${SECTIONS:-"same e2e index alloc copy scaling"}
@@ -99,6 +100,30 @@ if want ab && [ -x "$G/bin/${AB_BIN:-none}" ]; then
   gp new_csv_tiles -f CSV -lco GEOMETRY=AS_WKT "$W/new_csv_tiles.csv" "$W/tiles" --tiles off
   md5sum "$W"/old_csv.csv "$W"/new_csv.csv "$W"/new_csv_tiles.csv | sed "s#$W/##"
 fi
+if want stream; then
+  # Issue 14: the GeoPackage written while the union goes on (streamed_gpkg.h) against after it
+  # (--config GROUNDPLAN_WRITE_DURING_UNION NO), the same build; then the two files' tables compared.
+  echo "== written during the union (on) against after it (off), ${ROUNDS:-3} alternated rounds"
+  NO="--config GROUNDPLAN_WRITE_DURING_UNION NO"
+  for i in $(seq ${ROUNDS:-3}); do
+    gp "off_file_$i" -f GPKG "$W/off_file_$i.gpkg" "$W/city.gml" $NO
+    gp "on_file_$i" -f GPKG "$W/on_file_$i.gpkg" "$W/city.gml"
+    grep -o '"after_union_s[^,]*\|"slices_started_during_union[^,]*\|"slices"[^,]*' "$W/on_file_$i.json" | tr '\n' ' '; echo
+    gp "off_tiles_$i" -f GPKG "$W/off_tiles_$i.gpkg" "$W/tiles" --tiles off $NO
+    gp "on_tiles_$i" -f GPKG "$W/on_tiles_$i.gpkg" "$W/tiles" --tiles off
+  done
+  python3 - "$W/off_file_1.gpkg" "$W/on_file_1.gpkg" "$W/on_tiles_1.gpkg" <<'PY'
+import hashlib, sqlite3, sys
+def digest(f):
+    c = sqlite3.connect(f); h = hashlib.md5()
+    for q in ("SELECT * FROM ground_plans ORDER BY fid", "SELECT * FROM rtree_ground_plans_geom ORDER BY id",
+              "SELECT table_name, min_x, min_y, max_x, max_y, srs_id FROM gpkg_contents",
+              "SELECT * FROM gpkg_ogr_contents", "SELECT type, name, sql FROM sqlite_master ORDER BY name"):
+        for row in c.execute(q): h.update(repr(row).encode())
+    return h.hexdigest(), c.execute("PRAGMA integrity_check").fetchone()[0]
+for f in sys.argv[1:]: print(f.split("/")[-1], *digest(f))
+PY
+fi
 if want bench && [ -x $G/bin/citygml_read_bench ]; then
   echo "== one core: citygml_read_bench (CPU-time medians), two real samples and a 60 MB city of the generator"
   python3 tests/bench/gen_big_citygml.py "$W/c60.gml" 60 | tail -1
@@ -160,6 +185,12 @@ if [ "$BIG_MB" != 0 ]; then
   if want ab && [ -x "$G/bin/${AB_BIN:-none}" ]; then
     GP_BIN=$AB_BIN gp big_old -f GPKG "$W/big_old.gpkg" "$W/big.gml"
     gp big_all_2 -f GPKG "$W/big_all_2.gpkg" "$W/big.gml"
+  fi
+  if want stream; then
+    for i in 1 2; do
+      gp "off_big_$i" -f GPKG "$W/off_big_$i.gpkg" "$W/big.gml" --config GROUNDPLAN_WRITE_DURING_UNION NO
+      gp "on_big_$i" -f GPKG "$W/on_big_$i.gpkg" "$W/big.gml"
+    done
   fi
   if want xml; then
     gp big_all_2 -f GPKG "$W/big_all_2.gpkg" "$W/big.gml"

@@ -2,7 +2,8 @@
 """A new GeoPackage written by several writers side by side (issue 14, driver/cli/gpkg_slices.h) is the file one
 writer makes, seen from any reader: the same schema, rows (FID, every field, the geometry blob byte for byte),
 extent, feature count and spatial index; no slice file is left beside it. Options whose effect spans features
-keep one writer, and --stats says which was used and why."""
+keep one writer, and --stats says which was used and why. By default the writers start while the union goes on
+(driver/cli/streamed_gpkg.h); --config GROUNDPLAN_WRITE_DURING_UNION NO writes after it: both give that file."""
 import json
 import sqlite3
 
@@ -18,10 +19,24 @@ SCHEMA = "SELECT type, name, tbl_name, sql FROM sqlite_master ORDER BY type, nam
 CONTENTS = "SELECT table_name, data_type, identifier, min_x, min_y, max_x, max_y, srs_id FROM gpkg_contents ORDER BY 1"
 
 
+AFTER_UNION = ["--config", "GROUNDPLAN_WRITE_DURING_UNION", "NO"]
+
+
 def write(folder, name, src, threads, *args):
     out, stats = folder / f"{name}.gpkg", folder / f"{name}.json"
     run([BIN, "-q", "--threads", str(threads), "--stats", stats, "-f", "GPKG", out, src, *args])
     return out, json.loads(stats.read_text())
+
+
+def check_writers(stats, mode, writers):
+    """After the union: `writers` slices, as gpkg_writers says. During it: two or more writers (their number is
+    set from a guess of the plans' number), every slice of them written, the first ones before the union ended."""
+    w = stats["writer"]
+    if mode == "after":
+        assert w["writers"] == writers and "during_union" not in w, w
+    else:
+        assert w["during_union"] is True and 2 <= w["writers"] <= writers, w
+        assert w["slices"] >= w["writers"] and w["slices_started_during_union"] >= 1, w
 
 
 def same_file_content(a_path, b_path, tables):
@@ -39,11 +54,12 @@ def same_file_content(a_path, b_path, tables):
     assert a.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
 
 
-def test_slices_give_the_one_writer_file(tmp_path, parts):
+@pytest.mark.parametrize("mode", ["during", "after"])
+def test_slices_give_the_one_writer_file(tmp_path, parts, mode):
     one, one_stats = write(tmp_path, "one", parts, 1)
-    many, many_stats = write(tmp_path, "many", parts, 4)
+    many, many_stats = write(tmp_path, "many", parts, 4, *(AFTER_UNION if mode == "after" else []))
     assert one_stats["writer"] == {"writers": 1, "why_one": "one thread"}
-    assert many_stats["writer"]["writers"] == 4, many_stats["writer"]
+    check_writers(many_stats, mode, 4)
     plans = many_stats["counts"]["ground_plans"]
     assert plans > 4 * 8192 and plans == one_stats["counts"]["ground_plans"]
     same_file_content(many, one, ["ground_plans"])
@@ -67,17 +83,33 @@ def test_slices_give_the_one_writer_file(tmp_path, parts):
         "a slice file was left behind"
 
 
-def test_other_layers_and_a_new_name(tmp_path, parts):
+@pytest.mark.parametrize("mode", ["during", "after"])
+def test_other_layers_and_a_new_name(tmp_path, parts, mode):
+    """Slice 0 carries the other layers: written during the union, it waits for the union's end (problems)."""
+    extra = AFTER_UNION if mode == "after" else []
     layers = ["ground_plans", "problems", "plan_members"]
     one, _ = write(tmp_path, "one", parts, 1, *layers)
-    many, stats = write(tmp_path, "many", parts, 4, *layers)
-    assert stats["writer"]["writers"] == 4
+    many, stats = write(tmp_path, "many", parts, 4, *extra, *layers)
+    check_writers(stats, mode, 4)
     assert stats["counts"]["problems"] >= 5
     same_file_content(many, one, layers)
     one, _ = write(tmp_path, "one_nln", parts, 1, "-nln", "blocks")
-    many, stats = write(tmp_path, "many_nln", parts, 3, "-nln", "blocks")
-    assert stats["writer"]["writers"] == 3
+    many, stats = write(tmp_path, "many_nln", parts, 3, *extra, "-nln", "blocks")
+    check_writers(stats, mode, 3)
     same_file_content(many, one, ["blocks"])
+
+
+@pytest.mark.parametrize("mode", ["during", "after"])
+def test_a_failed_write_leaves_nothing(tmp_path, parts, mode):
+    """A slice GDAL cannot write (here every one: a geometry column named as the FID column) fails the run, and
+    neither the destination nor a slice is left."""
+    out = tmp_path / "out" / "bad.gpkg"
+    out.parent.mkdir()
+    r = run([BIN, "-q", "--threads", "4", *(AFTER_UNION if mode == "after" else []), "-f", "GPKG",
+             "-lco", "GEOMETRY_NAME=fid", out, parts], check=False)
+    assert r.returncode == 1, r.stderr
+    assert "writing slice" in r.stderr and "could not write" in r.stderr, r.stderr
+    assert list(out.parent.iterdir()) == [], "something was left behind"
 
 
 @pytest.mark.parametrize("option", [["-where", "n_parts > 1"], ["-limit", "100"], ["-preserve_fid"]],

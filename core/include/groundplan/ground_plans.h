@@ -18,11 +18,26 @@ struct UnionStats {
   std::string backend;          // "cpu" or "cuda"
 };
 
+/// Where the plans can go while later blocks are still being united (issue 14: a writer that starts before the union
+/// ends). The plans of the result are the blocks' plans in block order; a feed is told each block's plans as soon as
+/// that block is united, from the union's threads, in any order: it must be thread-safe. The result is unchanged.
+class PlanFeed {
+ public:
+  virtual ~PlanFeed() = default;
+  /// Once, before any block is united: how many blocks there are.
+  virtual void begin(std::size_t blocks) = 0;
+  /// Block `b`'s plans, in their order in the result (after every plan of the blocks before b); once a block.
+  virtual void block_done(std::size_t b, const std::vector<GroundPlan>& plans) = 0;
+  /// Once, last, also when the union stops early (an exception, a cancel): `complete` false then.
+  virtual void end(bool complete) = 0;
+};
+
 struct UnionParams {
   double resolution_m = 0;     // raster pixel for blocks/seeds; 0 = automatic (paper §5). Exactness never depends on it.
   Device device = Device::Auto;
   int threads = 0;             // 0 = all cores
   UnionStats* stats = nullptr; // out, optional
+  PlanFeed* feed = nullptr;    // optional: told the plans block by block (see PlanFeed); not with a level of detail
 };
 
 /// The exact union of `footprints` (working CRS, metres), one GroundPlan per connected region.

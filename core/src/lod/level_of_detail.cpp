@@ -264,6 +264,9 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   LodStats local;
   LodStats& st = stats ? *stats : local;
   if (!lod.any()) return build_ground_plans(footprints, union_params, problems, progress);
+  // The steps below change the union's plans: no feed sees them before they are final (the feed is never begun).
+  UnionParams exact_params = union_params;
+  exact_params.feed = nullptr;
 
   // 1. Snap the footprints (their copies: the footprints layer keeps what the source said).
   const std::vector<Footprint>* src = &footprints;
@@ -277,11 +280,11 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     st.snap_s = seconds_since(t0);
   }
   // 2. The exact union.
-  std::vector<GroundPlan> plans = build_ground_plans(*src, union_params, problems, progress.sub(0, 0.8));
+  std::vector<GroundPlan> plans = build_ground_plans(*src, exact_params, problems, progress.sub(0, 0.8));
   // 3. Gaps and cavities narrower than D.
   if (lod.close_gaps_m > 0) {
     const auto t0 = clock_type::now();
-    plans = close_gaps(plans, lod.close_gaps_m, union_params, &st);
+    plans = close_gaps(plans, lod.close_gaps_m, exact_params, &st);
     st.close_s = seconds_since(t0);
     if (st.close_plans_failed)
       problems.push_back(Problem{"", "", "lod", "CLOSE_GAPS_FAILED",

@@ -79,11 +79,24 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
     params.stats->backend = backend->name();
   }
 
-  // Largest blocks first, so that one big block does not finish last on one core.
+  // Blocks are taken from one queue in this order: the large ones first, largest first, so that one big block
+  // does not finish last on one core; then the others in block order, so that the plans are final from the first
+  // block on while the union goes on (a PlanFeed's writer can start on them).
+  const std::size_t large = std::max<std::size_t>(64, fps.indices.size() / (16 * static_cast<std::size_t>(threads)));
   std::vector<std::size_t> order(blocks.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(),
+  const auto large_end = std::stable_partition(order.begin(), order.end(),
+                                               [&](std::size_t b) { return blocks[b].footprints.size() >= large; });
+  std::stable_sort(order.begin(), large_end,
                    [&](std::size_t a, std::size_t b) { return blocks[a].footprints.size() > blocks[b].footprints.size(); });
+
+  struct FeedEnd {  // the feed is told the end also when a block's union throws or the run is cancelled
+    PlanFeed* feed;
+    ~FeedEnd() {
+      if (feed) feed->end(false);
+    }
+  } feed_end{params.feed};
+  if (params.feed) params.feed->begin(blocks.size());
 
   std::vector<detail::BlockResult> results(blocks.size());
   std::atomic<std::size_t> done{0};
@@ -102,6 +115,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
                                      std::string("the union of this footprint's block failed: ") + e.what()});
       results[bi] = std::move(r);
     }
+    if (params.feed) params.feed->block_done(bi, results[bi].plans);
     const std::size_t d = ++done;
     if (progress && std::this_thread::get_id() == caller && (d % 64 == 0 || d == blocks.size()))
       stage.report(static_cast<double>(d) / static_cast<double>(blocks.size()), "union of blocks");
@@ -109,13 +123,27 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   if (threads == 1 || blocks.size() <= 1) {
     for (std::size_t oi = 0; oi < blocks.size(); ++oi) one(oi);
   } else {
+    // One queue: every thread takes the next block in `order`, so that blocks finish close to that order. A
+    // throw (a cancel) stops the other threads at their next block.
+    std::atomic<std::size_t> next{0};
+    std::atomic<bool> stop{false};
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t oi = r.begin(); oi != r.end(); ++oi) one(oi);
-                        });
+      tbb::parallel_for(0, threads, [&](int) {
+        while (!stop.load(std::memory_order_relaxed)) {
+          const std::size_t oi = next.fetch_add(1, std::memory_order_relaxed);
+          if (oi >= blocks.size()) break;
+          try {
+            one(oi);
+          } catch (...) {
+            stop = true;
+            throw;
+          }
+        }
+      }, tbb::simple_partitioner());
     });
   }
+  if (params.feed) params.feed->end(true);  // every block's plans told: the feed's last waiters go on now
+  feed_end.feed = nullptr;
   // The plans in block order: moved into place side by side (offsets first), problems in order after.
   std::vector<std::size_t> first(results.size() + 1, 0);
   for (std::size_t bi = 0; bi < results.size(); ++bi) first[bi + 1] = first[bi] + results[bi].plans.size();

@@ -10,6 +10,7 @@
 #include <groundplan/types.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 namespace groundplan::gis {
 
 enum class FootprintMode { Auto, GroundSurface, Decompose };
+struct PipelineResult;
 
 struct PipelineOptions {
   std::vector<std::string> inputs;  // files or folders (a folder: its CityGML, KML/KMZ, glTF files, sorted by name)
@@ -41,6 +43,11 @@ struct PipelineOptions {
   /// (issue 22, gis/ogr_ranges.h): 0 = automatic (about four ranges a thread, at least 20000 features; never with
   /// one thread), < 0 = never; read_chunk_bytes < 0 also means never. The result is the same either way.
   std::int64_t read_range_features = 0;
+  /// Called once the inputs are read, before the union, with the result so far (footprints, CRS): a feed it returns
+  /// is told the plans block by block while the union goes on (ground_plans.h PlanFeed; the CLI writes them
+  /// meanwhile). Not called with a level of detail, whose steps change the union's plans. Empty, or null returned:
+  /// none.
+  std::function<PlanFeed*(const PipelineResult& read)> plan_feed;
 };
 
 /// How the inputs were read (--stats "reading").
