@@ -149,7 +149,10 @@ bool StreamedGpkg::write_one(std::size_t k, std::size_t first, std::size_t last,
     layer->restrict_to(first, last);
     src = GDALDataset::ToHandle(new FeedDataset(std::move(layer)));
   }
-  if (!src) return false;
+  if (!src) {
+    fail("slice " + std::to_string(k) + " of the plans: no dataset to write it from");
+    return false;
+  }
   std::vector<std::string> args = setup_.write.flags;
   args.push_back("-preserve_fid");  // the source's FIDs are the plans' indices + 1: slices append in any order
   if (k == 0)

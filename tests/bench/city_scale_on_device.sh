@@ -187,7 +187,7 @@ if [ "$BIG_MB" != 0 ]; then
     gp big_all_2 -f GPKG "$W/big_all_2.gpkg" "$W/big.gml"
   fi
   if want stream; then
-    for i in 1 2; do
+    for i in $(seq ${BIG_ROUNDS:-2}); do
       gp "off_big_$i" -f GPKG "$W/off_big_$i.gpkg" "$W/big.gml" --config GROUNDPLAN_WRITE_DURING_UNION NO
       gp "on_big_$i" -f GPKG "$W/on_big_$i.gpkg" "$W/big.gml"
     done
