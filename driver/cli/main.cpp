@@ -356,6 +356,30 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
 }
 
 
+/// ogr2ogr's options without the layer names (they come last); the layers written.
+std::vector<std::string> option_flags(const Ogr2ogrArgs& ogr) {
+  return {ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size())};
+}
+std::vector<std::string> written_layers(const Ogr2ogrArgs& ogr) {
+  return ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+}
+
+using AnotherDataset = std::function<groundplan::driver::OGRGroundPlanDataSource*(int threads)>;
+
+/// The slices' source over the one-process result: a dataset from `another` (on `threads` threads) serving the plans
+/// [first, last); null where it cannot be made, and that slice fails, and so the write (gpkg_slices.h).
+groundplan::cli::SliceSource slice_source(const AnotherDataset& another, int threads) {
+  return [&another, threads](std::size_t first, std::size_t last) -> GDALDatasetH {
+    auto* d = another(threads);
+    if (!d || !d->layer("ground_plans")) {
+      delete d;
+      return nullptr;
+    }
+    d->layer("ground_plans")->restrict_to(first, last);
+    return GDALDataset::ToHandle(d);
+  };
+}
+
 /// The writer of a new GeoPackage that starts while the union goes on (streamed_gpkg.h), or null where the plans are
 /// written after the union: not a new GeoPackage whose index the CLI packs, an ogr2ogr option that rules slices out
 /// (gpkg_slices.h), a level of detail (its steps change the union's plans), one thread, or
@@ -368,10 +392,9 @@ std::unique_ptr<groundplan::cli::StreamedGpkg> stream_plans(const Ogr2ogrArgs& o
   if (threads < 2) return nullptr;
   groundplan::cli::StreamedGpkg::Setup setup;
   setup.write.dst = ogr.dst;
-  // As write_output: ogr2ogr's options without the layer names, the index packed afterwards.
-  setup.write.flags.assign(ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size()));
-  setup.write.flags.insert(setup.write.flags.end(), {"-lco", "SPATIAL_INDEX=NO"});
-  setup.write.layers = ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+  setup.write.flags = option_flags(ogr);
+  setup.write.flags.insert(setup.write.flags.end(), {"-lco", "SPATIAL_INDEX=NO"});  // packed afterwards, as write_output
+  setup.write.layers = written_layers(ogr);
   if (!groundplan::cli::slices_ruled_out(setup.write.flags, setup.write.layers, "ground_plans").empty()) return nullptr;
   setup.write.progress = ogr.progress && !ogr.quiet;
   setup.threads = threads;
@@ -385,19 +408,16 @@ std::unique_ptr<groundplan::cli::StreamedGpkg> stream_plans(const Ogr2ogrArgs& o
 /// `another`, where given, makes one more dataset like `ds` (the one-process result): a new GeoPackage is then
 /// written by several writers side by side (gpkg_slices.h).
 WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads,
-                          const std::function<groundplan::driver::OGRGroundPlanDataSource*(int threads)>& another = {},
-                          groundplan::cli::StreamedGpkg* streamed = nullptr) {
+                          const AnotherDataset& another = {}, groundplan::cli::StreamedGpkg* streamed = nullptr) {
   WriteOutcome w;
   const bool dbf = writes_dbf(ogr);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
   // Streamed, the destination exists by now: it is the new GeoPackage the index is packed for.
   const bool own_index = (streamed && streamed->engaged()) || packs_gpkg_index(ogr);
   w.own_index = own_index;
-  // ogr2ogr's options without the layer names (they come last), then the layers.
-  std::vector<std::string> flags(ogr.options.begin(),
-                                 ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size()));
+  std::vector<std::string> flags = option_flags(ogr);
   if (own_index) flags.insert(flags.end(), {"-lco", "SPATIAL_INDEX=NO"});
-  const std::vector<std::string> layers = ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
+  const std::vector<std::string> layers = written_layers(ogr);
   std::vector<std::string> vt_args = flags;
   vt_args.insert(vt_args.end(), layers.begin(), layers.end());
   const auto t_write = clock::now();
@@ -414,16 +434,7 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
     // The slices were written while the union went on (streamed_gpkg.h): slice 0 where it carries other layers,
     // then what is left of the writing and appending.
     writers = 0;
-    const groundplan::cli::SliceSource slice0 = [&](std::size_t first, std::size_t last) -> GDALDatasetH {
-      auto* d = another(std::max(1, n_threads / streamed->writers()));
-      if (!d || !d->layer("ground_plans")) {
-        delete d;
-        return nullptr;
-      }
-      d->layer("ground_plans")->restrict_to(first, last);
-      return GDALDataset::ToHandle(d);
-    };
-    const auto out = streamed->finish(slice0);
+    const auto out = streamed->finish(slice_source(another, std::max(1, n_threads / streamed->writers())));
     write_ok = out.ok;
     if (!out.ok) std::fprintf(stderr, "groundplan: %s\n", out.error.c_str());
     w.writer = {{"writers", streamed->writers()},
@@ -445,16 +456,7 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
       sw.plans = plans;
       sw.writers = writers;
       sw.progress = ogr.progress && !ogr.quiet;
-      const int per_writer = std::max(1, n_threads / writers);
-      const groundplan::cli::SliceSource source = [&](std::size_t first, std::size_t last) -> GDALDatasetH {
-        auto* d = another(per_writer);
-        if (!d || !d->layer("ground_plans")) {
-          delete d;
-          return nullptr;  // that slice fails, and so the write (gpkg_slices.h)
-        }
-        d->layer("ground_plans")->restrict_to(first, last);
-        return GDALDataset::ToHandle(d);
-      };
+      const groundplan::cli::SliceSource source = slice_source(another, std::max(1, n_threads / writers));
       const auto slice = csv ? groundplan::cli::write_csv_slices(sw, source, vector_translate)
                              : groundplan::cli::write_gpkg_slices(sw, source, vector_translate);
       write_ok = slice.ok;
@@ -539,13 +541,6 @@ void say_nothing_usable(const groundplan::gis::TiledResult& r, const Ogr2ogrArgs
 }
 
 /// ogr2ogr's options without the layer names (they come last), and the layers written (ground_plans unless named).
-std::vector<std::string> option_flags(const Ogr2ogrArgs& ogr) {
-  return {ogr.options.begin(), ogr.options.end() - static_cast<std::ptrdiff_t>(ogr.layers.size())};
-}
-std::vector<std::string> written_layers(const Ogr2ogrArgs& ogr) {
-  return ogr.layer_named ? ogr.layers : std::vector<std::string>{"ground_plans"};
-}
-
 /// --stats of a tiled run (one process or ranks): counts, timings, "tiles", "mpi". `plans`: in the whole dataset
 /// (rank 0 of a run whose ranks write their own plans holds none of theirs). False (said) when it cannot be written.
 bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::TiledResult& r, std::size_t plans,

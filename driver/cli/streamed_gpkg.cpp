@@ -106,8 +106,7 @@ void StreamedGpkg::end(bool complete) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ended_ = true;
-    complete_ = complete && prefix_ == done_.size();
-    if (!complete_ && !failed_) {
+    if (!(complete && prefix_ == done_.size()) && !failed_) {
       failed_ = true;
       error_ = "the union stopped before its last block";
     }

@@ -84,7 +84,7 @@ class StreamedGpkg final : public PlanFeed {
   std::vector<std::size_t> first_;                  // first plan of each block of the final prefix
   std::size_t prefix_ = 0;                          // blocks before this one are all united
   std::size_t ready_ = 0;                           // plans final: those of the prefix
-  bool ended_ = false, complete_ = false, failed_ = false, appended_ = false;
+  bool ended_ = false, failed_ = false, appended_ = false;
   std::string error_;
   std::size_t slice_plans_ = 0;             // plans a slice (the last one fewer)
   std::vector<char> written_;               // slice k written (grown as needed)
