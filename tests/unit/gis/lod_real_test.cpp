@@ -22,19 +22,21 @@ namespace groundplan {
 namespace {
 
 struct Sample {
-  const char* path;  // relative to sample_data/ or ../shared/data
+  const char* path;  // relative to sample_data/, or as in ../shared/data (test::shared_data)
   bool shared;
   bool lod2;         // the area goal for --snap is stated for LoD2 samples
 };
 
 void PrintTo(const Sample& s, std::ostream* os) { *os << s.path; }
 
+std::string path_of(const Sample& s) { return s.shared ? test::shared_data(s.path) : test::sample_data(s.path); }
+
 const gis::PipelineResult& exact(const Sample& s) {
   static std::map<std::string, gis::PipelineResult> cache;
   auto it = cache.find(s.path);
   if (it == cache.end()) {
     gis::PipelineOptions o;
-    o.inputs = {s.shared ? test::shared_data(s.path) : test::sample_data(s.path)};
+    o.inputs = {path_of(s)};
     it = cache.emplace(s.path, gis::run_pipeline(o)).first;
   }
   return it->second;
@@ -82,7 +84,10 @@ double widest_vertex_clearance(const Ring& r) {
   return widest;
 }
 
-class LodOnRealData : public ::testing::TestWithParam<Sample> {};
+class LodOnRealData : public ::testing::TestWithParam<Sample> {
+ protected:
+  void SetUp() override { GROUNDPLAN_SKIP_IF_MISSING(path_of(GetParam())); }
+};
 
 TEST_P(LodOnRealData, EverySettingGivesValidDisjointPlans) {
   const gis::PipelineResult& r = exact(GetParam());
@@ -159,12 +164,15 @@ INSTANTIATE_TEST_SUITE_P(
                       Sample{"plateau-niiza/53392547_bldg_6697_op2.gml", false, false},
                       Sample{"niedersachsen-lorup/LoD1_24065862_2_2021-01-25.gml", false, false},
                       Sample{"tum-main-entrance/TUM-Main-Entrance.gml", false, true},
-                      Sample{"citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml", true, true},
                       Sample{"citygml1-niedersachsen-lod1-4tiles", true, false},
                       Sample{"citygml2-plateau-japan-lod1", true, false},
-                      Sample{"citygml-citygml4j-samples/lod2_buildings_v3.gml", true, true},
-                      Sample{"citygml-ogc-spec-samples/plateau_53394517_bldg_6697_2_op_CityGML2.gml", true, true},
                       Sample{"kml-collada-macky-google", true, true}));
+// Samples that may not be redistributed (the third-party folder): skipped without it.
+INSTANTIATE_TEST_SUITE_P(
+    ThirdParty, LodOnRealData,
+    ::testing::Values(Sample{"citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml", true, true},
+                      Sample{"citygml-citygml4j-samples/lod2_buildings_v3.gml", true, true},
+                      Sample{"citygml-ogc-spec-samples/plateau_53394517_bldg_6697_2_op_CityGML2.gml", true, true}));
 
 }  // namespace
 }  // namespace groundplan
