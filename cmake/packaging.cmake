@@ -71,6 +71,10 @@ set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)   # dependencies from the linked libraries (libgdal32, libgeos-c1v5 ...)
 set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)   # shlibs for libgroundplan.so.0, and the ldconfig trigger
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "gdal-bin")
+# The Python module (built for the build machine's python3) converts to Shapely and GeoPandas when asked; the CLI
+# and the GDAL plugin need neither. The QGIS plugin needs QGIS.
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3, python3-shapely")
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-geopandas, qgis, openmpi-bin")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)   # Debian's; packaging/build-deb.sh also configures with it
 set(CPACK_COMPONENTS_ALL runtime)
 set(CPACK_DEB_COMPONENT_INSTALL OFF)

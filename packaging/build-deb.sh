@@ -8,6 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build-deb}
+bash packaging/install-deps.sh
 # shellcheck disable=SC2086
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr \
   -DGROUNDPLAN_BUILD_TESTS=OFF -DGROUNDPLAN_BUILD_BENCH=OFF ${CMAKE_ARGS:-} >/dev/null
