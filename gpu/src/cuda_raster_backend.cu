@@ -306,8 +306,13 @@ RasterBackend* make_backend(std::uint64_t band_keys, char* error, std::size_t er
   int count = 0;
   const cudaError_t e = cudaGetDeviceCount(&count);
   if (e != cudaSuccess || count <= 0) {
-    const std::string why = std::string("no CUDA device answers (cudaGetDeviceCount: ") +
-                            (e != cudaSuccess ? cudaGetErrorString(e) : "no device") + ")";
+    // without libcuda (no NVIDIA driver) the static runtime says "driver version is insufficient": say both
+    const std::string why =
+        e == cudaErrorInsufficientDriver
+            ? std::string("no CUDA device answers: no NVIDIA driver, or one older than this CUDA runtime (cudaGetDeviceCount: ") +
+                  cudaGetErrorString(e) + ")"
+            : std::string("no CUDA device answers (cudaGetDeviceCount: ") +
+                  (e != cudaSuccess ? cudaGetErrorString(e) : "no device") + ")";
     cudaGetLastError();
     if (error_size) {
       const std::size_t n = std::min(why.size(), error_size - 1);

@@ -19,7 +19,8 @@ and around generated text:
   <!-- end generated -->
 
 COMMAND runs from the repository root like a runnable block and what it prints on stdout must equal the text
-between the two lines (--update rewrites the text instead).
+between the two lines (--update rewrites the text instead). Relative links must lead to a file, and a
+`#anchor` to one of its headings.
 
 A fence whose info string starts with sh, bash, shell or console and holds anything else is an error, so a
 typo cannot turn an example off. Each document runs in a fresh folder holding links to every entry of the
@@ -113,6 +114,37 @@ def parse(path, rel):
     return blocks
 
 
+LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+def slug(heading):
+    """GitHub's anchor for a heading: lower case, punctuation dropped, spaces to dashes."""
+    text = re.sub(r"[^\w\- ]", "", heading.strip().lower())
+    return text.replace(" ", "-")
+
+
+def anchors(path):
+    text = path.read_text(encoding="utf-8")
+    text = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)   # no headings inside code blocks
+    return {slug(m.group(1)) for m in re.finditer(r"^#+\s+(.*)$", text, re.M)}
+
+
+def check_links(path, rel):
+    """Relative links of a document: the file must exist, and the #anchor be one of its headings."""
+    bad = []
+    for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        for target in LINK.findall(line):
+            if re.match(r"^[a-z]+:", target):
+                continue  # http:, https:, mailto:
+            file, _, anchor = target.partition("#")
+            dest = (path.parent / file).resolve() if file else path
+            if not dest.exists():
+                bad.append(f"{rel}:{n}: link to {target}: no such file")
+            elif anchor and dest.suffix == ".md" and anchor not in anchors(dest):
+                bad.append(f"{rel}:{n}: link to {target}: no heading with that anchor")
+    return bad
+
+
 def make_root(source, build):
     """A folder that looks like the repository root of a source build, for one document's examples."""
     root = pathlib.Path(tempfile.mkdtemp(prefix="gp-doc-"))
@@ -153,6 +185,7 @@ def main():
     failures, counts = [], {"run": 0, "skip": 0, "generated": 0, "missing": 0}
     for rel in files:
         path = source / rel
+        failures += check_links(path, rel)
         try:
             blocks = parse(path, rel)
         except ValueError as e:
