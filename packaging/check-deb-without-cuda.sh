@@ -45,10 +45,10 @@ for f in $(in_root "dpkg -L groundplan" | grep -E '(/bin/groundplan|\.so[.0-9]*)
 done
 
 echo "== the GDAL plugin and the CLI load"
-in_root "ogrinfo --format GroundPlan" | grep -E "Short Name: GroundPlan" || fail "ogrinfo --format GroundPlan"
-in_root "groundplan --help" | head -1 | grep -q "ground plans" || fail "groundplan --help"
-in_root "groundplan --help >/dev/null" || fail "groundplan --help exit status"
-echo "groundplan --help: ok"
+out=$(in_root "ogrinfo --format GroundPlan") || fail "ogrinfo --format GroundPlan: exit status $?"
+grep -E "Short Name: GroundPlan" <<<"$out" || fail "ogrinfo --format GroundPlan: $out"
+out=$(in_root "groundplan --help") || fail "groundplan --help: exit status $?"
+grep -m1 "ground plans" <<<"$out" || fail "groundplan --help: $out"
 
 echo "== a run, the driver, Python"
 out=$(in_root "cd /tmp && groundplan -overwrite --verify -f GPKG p.gpkg /proof/$(basename $sample) 2>&1") || fail "groundplan run: $out"
