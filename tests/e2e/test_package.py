@@ -101,7 +101,8 @@ def _elf_files(folder):
 
 def test_nothing_packaged_needs_the_cuda_runtime(root):
     """The package loads where CUDA is absent: no packaged binary needs libcudart or libcuda (the CUDA backend, where
-    built, is a module loaded when asked for, with the CUDA runtime linked in statically), and the Depends name none."""
+    built, is a module loaded when asked for, with the CUDA runtime linked in statically). packaging/
+    check-deb-without-cuda.sh goes further: it installs the package in a Debian chroot without CUDA and runs it."""
     elfs = _elf_files(root)
     assert {p.name for p in elfs} >= {"groundplan", "ogr_GroundPlan.so"}, elfs
     for p in elfs:
