@@ -19,7 +19,8 @@ and around generated text:
   <!-- end generated -->
 
 COMMAND runs from the repository root like a runnable block and what it prints on stdout must equal the text
-between the two lines (--update rewrites the text instead). Relative links must lead to a file, and a
+between the two lines (--update rewrites the text instead); where COMMAND is a program of the build that this
+build did not make (build/bin/lod_report without the benchmarks) it is skipped with one line. Relative links must lead to a file, and a
 `#anchor` to one of its headings.
 
 A fence whose info string starts with sh, bash, shell or console and holds anything else is an error, so a
@@ -203,9 +204,14 @@ def main():
                     counts["skip"] += 1
                     continue
                 missing = [p for p in b.requires if shutil.which(p) is None]
+                program = b.text.split()[0] if b.kind == "generated" else ""
                 if missing:
                     counts["missing"] += 1
                     print(f"{b.where()}: skipped: needs {', '.join(missing)} on PATH")
+                    continue
+                if program.startswith("build/") and not (root / program).exists():
+                    counts["missing"] += 1
+                    print(f"{b.where()}: skipped: {program} is not built here (-DGROUNDPLAN_BUILD_BENCH=ON builds it)")
                     continue
                 counts[b.kind] += 1
                 failed_before = len(failures)
