@@ -123,7 +123,8 @@ TEST_P(LodOnRealData, SnapOneMillimetreMeetsTheGoal) {
   const testing::LodMetrics after = testing::measure_plans(out.plans, 1e-3, 1e-3, 0);
   // Holes under 1e-3 m2 must be gone, except a hole that is no sliver at this tolerance: one with a
   // vertex farther than 1 mm from every edge not incident to it (the Berlin sample keeps one such hole,
-  // a wedge 3.6 mm wide and 0.48 m long: docs/level_of_detail.md). No such exception for slivers.
+  // a wedge 3.6 mm wide and 0.48 m long: lod_report in tests/bench/RESULTS.md). No such exception for
+  // slivers.
   std::size_t wide = 0;
   for (const GroundPlan& g : out.plans)
     for (const Ring& h : g.polygon.holes)
@@ -132,8 +133,8 @@ TEST_P(LodOnRealData, SnapOneMillimetreMeetsTheGoal) {
   RecordProperty("snap_small_holes_left", std::to_string(after.small_holes));
   EXPECT_EQ(after.close_pairs, 0u) << "before: " << before.close_pairs;
   // LoD1 tiles with millimetre coordinates hold wedge gaps (0 to 1 mm wide along a whole wall) whose
-  // closing is the join asked for; their area is reported in docs/level_of_detail.md, bounded here by
-  // what a 1 mm move of every plan's outline could add.
+  // closing is the join asked for; their area is reported by lod_report (tests/bench/RESULTS.md), bounded
+  // here by what a 1 mm move of every plan's outline could add.
   const double rel = std::fabs(after.area_m2 - before.area_m2) / before.area_m2;
   if (GetParam().lod2)
     EXPECT_LT(rel, 1e-6) << before.area_m2 << " -> " << after.area_m2;
