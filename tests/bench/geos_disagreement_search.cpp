@@ -67,13 +67,17 @@ int main(int argc, char** argv) {
   double min_exp = -6;     // --min-size 1e-6: the smallest cluster, metres
   bool wide_only = false;  // --wide: only cases whose differences are not all narrower than the snap pitch
   unsigned long seed = 1;
-  for (int i = 1; i < argc; ++i)
+  for (int i = 1; i < argc; ++i) {
+    const bool has_value = i + 1 < argc;
     if (!std::strcmp(argv[i], "--wide")) wide_only = true;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--trials")) trials = std::atol(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--seed")) seed = std::strtoul(argv[i + 1], nullptr, 10);
-    else if (!std::strcmp(argv[i], "--max-found")) max_found = std::atol(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--min-size")) min_exp = std::log10(std::atof(argv[i + 1]));
+    else if (has_value && !std::strcmp(argv[i], "--trials")) trials = std::atol(argv[++i]);
+    else if (has_value && !std::strcmp(argv[i], "--seed")) seed = std::strtoul(argv[++i], nullptr, 10);
+    else if (has_value && !std::strcmp(argv[i], "--max-found")) max_found = std::atol(argv[++i]);
+    else if (has_value && !std::strcmp(argv[i], "--min-size")) min_exp = std::log10(std::atof(argv[++i]));
+    else {
+      std::fprintf(stderr, "unknown argument %s\n", argv[i]);
+      return 2;
+    }
   }
   std::mt19937_64 rng(seed);
   long invented = 0, dropped = 0, geos_wrong = 0, ours_wrong = 0;
