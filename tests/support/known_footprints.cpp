@@ -265,6 +265,14 @@ Model podium() {
                      1400, 1400);
 }
 
+/// A 6 m podium (30 x 20) with a 10 x 10 tower of 50 m flush with its north-east corner: the tower's outer walls
+/// and the podium's are one plane there.
+Model podium_corner() {
+  std::vector<std::vector<std::array<double, 2>>> z(2, std::vector<std::array<double, 2>>(2, {0, 6}));
+  z[1][1] = {0, 50};
+  return cells_model({{0, 20, 30}, {0, 10, 20}, z}, "POLYGON((0 0,30 0,30 20,0 20,0 0))", 600, 600);
+}
+
 /// Terraces: three storeys set back 5 m on every side (30 x 20, 4 / 8 / 16 m).
 Model terraces() {
   std::vector<std::vector<std::array<double, 2>>> z(4, std::vector<std::array<double, 2>>(6, {0, 4}));
@@ -300,7 +308,7 @@ struct Family {
   Model (*make)();
 };
 
-constexpr std::array<Family, 15> kFamilies{{{"eaves_open", eaves_open},
+constexpr std::array<Family, 16> kFamilies{{{"eaves_open", eaves_open},
                                           {"eaves_soffit", eaves_soffit},
                                           {"slab_roof", slab_roof},
                                           {"cantilever", cantilever},
@@ -312,6 +320,7 @@ constexpr std::array<Family, 15> kFamilies{{{"eaves_open", eaves_open},
                                           {"disconnected", disconnected},
                                           {"plinth", plinth},
                                           {"podium", podium},
+                                          {"podium_corner", podium_corner},
                                           {"terraces", terraces},
                                           {"multi_tower", multi_tower},
                                           {"arcade", arcade}}};

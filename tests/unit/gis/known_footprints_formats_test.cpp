@@ -28,7 +28,7 @@ namespace {
 
 using Tri = std::array<Point3, 3>;
 
-const char* kFamilies[] = {"plinth", "podium", "terraces", "multi_tower", "arcade"};
+const char* kFamilies[] = {"plinth", "podium", "podium_corner", "terraces", "multi_tower", "arcade"};
 
 /// The family's closed mesh written as triangles, with its floor (tests/support/known_footprints.h).
 const test::KnownFootprint& model(const std::string& family) {
