@@ -1139,7 +1139,7 @@ int run(int argc, char** argv, Ranks* ranks) {
                           : c.verdict() == groundplan::gis::GeosComparison::Verdict::MatchGeosDiffers
                               ? "match_geos_differs"
                               : "mismatch";
-    verify_json = {{"match", ok}, {"verdict", verdict}, {"footprints_missing_ground", missing_ground}, {"level_of_detail", lod}, {"valid_and_disjoint", c.invalid_ours == 0 && c.overlapping_ours == 0},        {"symdiff_area_m2", c.symdiff_area}, {"area_m2", c.area_ours},
+    verify_json = {{"match", c.matches() && missing_ground == 0}, {"verdict", verdict}, {"footprints_missing_ground", missing_ground}, {"level_of_detail", lod}, {"valid_and_disjoint", c.invalid_ours == 0 && c.overlapping_ours == 0},        {"symdiff_area_m2", c.symdiff_area}, {"area_m2", c.area_ours},
                    {"area_geos_m2", c.area_geos}, {"polygons", c.polygons_ours},      {"polygons_geos", c.polygons_geos},
                    {"holes", c.holes_ours},       {"holes_geos", c.holes_geos},        {"invalid", c.invalid_ours},
                    {"holes_geos_artifacts", c.holes_geos_artifacts}, {"holes_geos_dropped", c.holes_geos_dropped},

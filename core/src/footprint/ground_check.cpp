@@ -47,9 +47,9 @@ double ring_area(const Ring& r) {
 std::string GroundCheck::reason() const {
   char buf[300];
   std::snprintf(buf, sizeof buf,
-                "the footprint (%.1f m2) leaves out %.1f m2 of the building's lowest horizontal faces (%.1f m2 "
-                "at z %.2f): ground the building stands on",
-                footprint_m2, uncovered_m2, lowest_m2, zmin);
+                "the footprint (%.1f m2) leaves out %.1f m2 of ground under the building's lowest horizontal faces "
+                "(within %.2g m of its lowest point, z %.2f): ground the building stands on",
+                footprint_m2, uncovered_m2, level_m, zmin);
   return buf;
 }
 
@@ -80,6 +80,18 @@ GroundCheck check_ground(const Mesh& mesh, const std::vector<Polygon>& footprint
     if (std::isfinite(p.z)) g.zmin = std::min(g.zmin, p.z);
   if (!std::isfinite(g.zmin)) return g;
   const double cos_tol = std::cos(params.horizontal_tolerance_deg * kPi / 180.0);
+  // Where a thin slab lies low, its top and its bottom are both lowest faces over the same ground: a triangle
+  // left out counts once, where no other one left out already covers its centroid.
+  struct Out {
+    Point2 a, b, c;
+  };
+  std::vector<Out> left_out;
+  auto in_tri = [](const Out& t, double x, double y) {
+    auto side = [&](const Point2& p, const Point2& q) { return (q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x); };
+    const double d0 = side(t.a, t.b), d1 = side(t.b, t.c), d2 = side(t.c, t.a);
+    return (d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0);
+  };
+  g.level_m = params.level_tolerance_m;
   const double top = g.zmin + params.level_tolerance_m;
   for (const MeshFace& f : mesh.faces) {
     if (f.ring_count == 0 || f.kind == SurfaceKind::FootPrint || f.kind == SurfaceKind::RoofEdge) continue;
@@ -123,7 +135,9 @@ GroundCheck check_ground(const Mesh& mesh, const std::vector<Polygon>& footprint
       if (covered(cx, cy)) continue;
       bool in = ring_parity(mesh, f.first_ring, cx, cy, false);
       for (std::uint32_t r = f.first_ring + 1; r < f.first_ring + f.ring_count; ++r) in = ring_parity(mesh, r, cx, cy, in);
-      if (in) out += t * sign;
+      if (!in || std::any_of(left_out.begin(), left_out.end(), [&](const Out& u) { return in_tri(u, cx, cy); })) continue;
+      out += t * sign;
+      left_out.push_back({{o.x, o.y}, {p.x, p.y}, {q.x, q.y}});
     }
     g.uncovered_m2 += std::max(out, 0.0);
   }

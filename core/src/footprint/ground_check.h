@@ -18,11 +18,13 @@ namespace groundplan::footprint {
 
 struct GroundCheck {
   double footprint_m2 = 0;   // area of the footprint's polygons
-  double lowest_m2 = 0;      // plan area of the lowest horizontal faces (within level_tolerance_m of the lowest point)
-  double uncovered_m2 = 0;   // of those, outside the footprint
+  double lowest_m2 = 0;      // the lowest horizontal faces' areas (within level_tolerance_m of the lowest point),
+                             // summed: a low slab's top and bottom both count
+  double uncovered_m2 = 0;   // plan area under them outside the footprint, each place once
   double zmin = 0;           // the building's lowest point
-  /// Over 0.1 % of the lowest faces' area, and over 0.01 m², lies outside the footprint.
-  bool misses_ground() const { return uncovered_m2 > 1e-3 * lowest_m2 && uncovered_m2 > 0.01; }
+  double level_m = 0;        // the level tolerance the lowest faces were taken within
+  /// Over 0.1 % of the ground that footprint and lowest faces cover together, and over 0.01 m², is left out.
+  bool misses_ground() const { return uncovered_m2 > 1e-3 * (footprint_m2 + uncovered_m2) && uncovered_m2 > 0.01; }
   /// One sentence for the Problem.
   std::string reason() const;
 };
