@@ -200,7 +200,7 @@ int run(int argc, char** argv, Ranks* ranks) {
 
 int main(int argc, char** argv) {
   std::unique_ptr<groundplan::cli::Ranks> ranks;
-  groundplan::cli::sqlite_without_memory_statistics();  // before GDAL opens any SQLite file (gpkg_slices.h)
+  groundplan::output::sqlite_without_memory_statistics();  // before GDAL opens any SQLite file (gpkg_slices.h)
   try {
 #ifdef GROUNDPLAN_WITH_MPI
     // Only under mpirun: a plain start never initialises MPI (and so behaves as the CLI without MPI).

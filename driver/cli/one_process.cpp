@@ -55,7 +55,7 @@ int run_one_process(gis::PipelineOptions options, const Ogr2ogrArgs& ogr, const 
   const Progress progress = terminal_progress(ogr);
   // A new GeoPackage of many plans is written while the union goes on (streamed_gpkg.h).
   const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
-  std::unique_ptr<groundplan::cli::StreamedGpkg> streamed = stream_plans(ogr, options, id_chars);
+  std::unique_ptr<output::StreamedGpkg> streamed = stream_plans(ogr, options, id_chars);
   if (streamed)
     options.plan_feed = [&streamed](const PipelineResult& read) { return streamed->engage(read); };
   const auto result_ptr = std::make_shared<const PipelineResult>(groundplan::gis::run_pipeline(options, progress.sub(0, 1)));

@@ -57,12 +57,12 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   std::shared_ptr<const groundplan::gis::TiledResult> result = tiled_kept_by_each_rank(options, progress, ranks);
   const groundplan::gis::TiledResult& r = *result;
   const std::size_t plans = r.tiles.final_plans + r.tiles.reduced_plans;  // rank 0: over all ranks
-  groundplan::cli::TableSetup setup;
+  output::TableSetup setup;
   setup.dst = ogr.dst;
   setup.options = ogr.options;
   if (!ogr.layer_named) setup.options.push_back("ground_plans");
   const std::vector<std::string> layers = written_layers(ogr);
-  const std::string nln = groundplan::cli::table_name(option_flags(ogr), "");
+  const std::string nln = output::table_name(option_flags(ogr), "");
   for (const std::string& l : layers) setup.tables.push_back(layers.size() == 1 && !nln.empty() ? nln : l);
   if (root && r.footprints == 0) {
     say_nothing_usable(ogr, r.buildings_read, r.problems);
@@ -72,7 +72,7 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
                                                                result, 0, options.threads);
   auto* empty = new groundplan::driver::OGRGroundPlanDataSource(
       std::string(groundplan::driver::kPrefix) + ogr.src, std::make_shared<const NoPlans>(r), 0, options.threads);
-  const groundplan::cli::RankWrite w = groundplan::cli::write_from_every_rank(
+  const output::RankWrite w = output::write_from_every_rank(
       ranks, setup, mine, empty, [&ranks] { ranks.test_point("commit"); });
   if (!root) return w.ok ? 0 : 1;
   if (!ogr.quiet)
@@ -102,7 +102,7 @@ std::string why_rank_0_writes(const Ogr2ogrArgs& ogr, Ranks& ranks) {
   namespace fs = std::filesystem;
   std::string said, marker;
   if (ranks.rank() == 0) {
-    std::string why = packs_gpkg_index(ogr) ? groundplan::cli::slices_ruled_out(option_flags(ogr), written_layers(ogr),
+    std::string why = packs_gpkg_index(ogr) ? output::slices_ruled_out(option_flags(ogr), written_layers(ogr),
                                                                                 "ground_plans")
                                             : "not a new local GeoPackage whose spatial index the CLI packs";
     std::string token;
@@ -150,14 +150,14 @@ int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& o
   std::shared_ptr<const groundplan::gis::TiledResult> result = tiled_kept_by_each_rank(options, progress, ranks);
   const groundplan::gis::TiledResult& r = *result;
   const std::size_t plans = r.tiles.final_plans + r.tiles.reduced_plans;  // rank 0: over all ranks
-  std::unique_ptr<groundplan::cli::StagedOutput> staged;
-  groundplan::cli::RankGpkgWrite w;
+  std::unique_ptr<output::StagedOutput> staged;
+  output::RankGpkgWrite w;
   w.flags = option_flags(ogr);
   w.flags.insert(w.flags.end(), {"-lco", "SPATIAL_INDEX=NO"});  // packed once the slices are in (gpkg_rtree.h)
   w.layers = written_layers(ogr);
   w.progress = ogr.progress && !ogr.quiet;
   if (root) {
-    staged = std::make_unique<groundplan::cli::StagedOutput>(ogr.dst);
+    staged = std::make_unique<output::StagedOutput>(ogr.dst);
     w.dst = staged->path();
     const std::filesystem::path dst(w.dst);
     w.folder = dst.has_parent_path() ? dst.parent_path().string() : ".";
@@ -168,7 +168,7 @@ int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& o
   }
   const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
   const auto t_write = clock::now();
-  const groundplan::cli::RankGpkgOutcome o = groundplan::cli::write_gpkg_from_every_rank(
+  const output::RankGpkgOutcome o = output::write_gpkg_from_every_rank(
       ranks, w, r,
       [&] {
         return GDALDataset::ToHandle(new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, 0, options.threads));
@@ -200,7 +200,7 @@ int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& o
   WriteOutcome wo;
   wo.ok = wo.own_index = true;
   const auto t_index = clock::now();
-  const bool indexed = groundplan::cli::index_new_gpkg(
+  const bool indexed = output::index_new_gpkg(
       w.dst, static_cast<int>(groundplan::gis::thread_count(options.threads)), wo.built);
   if (wo.built.by_gdal)
     std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL built it instead\n",

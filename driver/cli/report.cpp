@@ -21,7 +21,7 @@ std::size_t count_holes(const PipelineResult& r) {
 
 /// --stats "spatial_index": the GeoPackage index packed by the CLI (gpkg_rtree.h); one form for the
 /// one-process and the tiled run.
-nlohmann::json spatial_index_json(const groundplan::cli::RtreeBuild& index) {
+nlohmann::json spatial_index_json(const output::RtreeBuild& index) {
   return {{"tables", index.tables},   {"entries", index.entries},   {"read_s", index.read_s}, {"write_s", index.write_s},
           {"commit_s", index.commit_s}, {"error", index.error}, {"by_gdal", index.by_gdal}};
 }

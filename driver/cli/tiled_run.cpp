@@ -83,8 +83,8 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
   // has finished (staged_output.h). A database: every rank writes its own plans (stage 5); a new GeoPackage: every
   // rank writes a slice (below); other files: rank 0 gets every plan and writes them all, the others only map and
   // reduce.
-  std::unique_ptr<groundplan::cli::StagedOutput> staged;
-  if (rank_count(ranks) > 1 && groundplan::cli::written_by_every_rank(ogr.format, ogr.dst))
+  std::unique_ptr<output::StagedOutput> staged;
+  if (rank_count(ranks) > 1 && output::written_by_every_rank(ogr.format, ogr.dst))
     return run_tiled_into_database(options, ogr, stats_path, progress, *ranks);
   // A new GeoPackage: every rank writes its own plans into a slice, rank 0 joins them (gpkg_rank_slices.h), unless
   // an option spans features or the ranks do not share the destination's folder (--stats "writer" says why).
@@ -97,7 +97,7 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
       ranks->barrier();  // rank 0 has written
       return 0;
     }
-    staged = std::make_unique<groundplan::cli::StagedOutput>(ogr.dst);
+    staged = std::make_unique<output::StagedOutput>(ogr.dst);
     ogr.dst = staged->path();
   }
   // Every rank waits for rank 0 here before the dataset is moved into place; rank 0's outcome is its return code.

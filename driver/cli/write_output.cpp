@@ -21,7 +21,7 @@ using gis::PipelineOptions;
 
 /// The slices' source over the one-process result: a dataset from `another` (on `threads` threads) serving the plans
 /// [first, last); null where it cannot be made, and that slice fails, and so the write (gpkg_slices.h).
-groundplan::cli::SliceSource slice_source(const AnotherDataset& another, int threads) {
+output::SliceSource slice_source(const AnotherDataset& another, int threads) {
   return [&another, threads](std::size_t first, std::size_t last) -> GDALDatasetH {
     auto* d = another(threads);
     if (!d || !d->layer("ground_plans")) {
@@ -54,27 +54,27 @@ bool vector_translate(const std::string& dst, GDALDatasetH src, const std::vecto
   return CPLGetLastErrorType() < CE_Failure;
 }
 
-std::unique_ptr<groundplan::cli::StreamedGpkg> stream_plans(const Ogr2ogrArgs& ogr, const PipelineOptions& options,
+std::unique_ptr<output::StreamedGpkg> stream_plans(const Ogr2ogrArgs& ogr, const PipelineOptions& options,
                                                             std::size_t id_chars) {
   if (!CPLTestBool(CPLGetConfigOption("GROUNDPLAN_WRITE_DURING_UNION", "YES"))) return nullptr;
   if (!packs_gpkg_index(ogr) || options.detail.any()) return nullptr;
   const int threads = static_cast<int>(groundplan::gis::thread_count(options.threads));
   if (threads < 2) return nullptr;
-  groundplan::cli::StreamedGpkg::Setup setup;
+  output::StreamedGpkg::Setup setup;
   setup.write.dst = ogr.dst;
   setup.write.flags = option_flags(ogr);
   setup.write.flags.insert(setup.write.flags.end(), {"-lco", "SPATIAL_INDEX=NO"});  // packed afterwards, as write_output
   setup.write.layers = written_layers(ogr);
-  if (!groundplan::cli::slices_ruled_out(setup.write.flags, setup.write.layers, "ground_plans").empty()) return nullptr;
+  if (!output::slices_ruled_out(setup.write.flags, setup.write.layers, "ground_plans").empty()) return nullptr;
   setup.write.progress = ogr.progress && !ogr.quiet;
   setup.threads = threads;
   setup.id_chars = id_chars;
   setup.translate = vector_translate;
-  return std::make_unique<groundplan::cli::StreamedGpkg>(std::move(setup));
+  return std::make_unique<output::StreamedGpkg>(std::move(setup));
 }
 
 WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads,
-                          const AnotherDataset& another, groundplan::cli::StreamedGpkg* streamed) {
+                          const AnotherDataset& another, output::StreamedGpkg* streamed) {
   WriteOutcome w;
   const bool dbf = writes_dbf(ogr);
   GDALDatasetH src_h = GDALDataset::ToHandle(ds);
@@ -94,7 +94,7 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
   int writers = 1;
   // A new GeoPackage or CSV file: the plans written by several writers side by side (gpkg_slices.h, csv_slices.h).
   std::error_code exists_ec;
-  const bool csv = !own_index && groundplan::cli::is_csv_file(ogr.format, ogr.dst) &&
+  const bool csv = !own_index && output::is_csv_file(ogr.format, ogr.dst) &&
                    !std::filesystem::exists(ogr.dst, exists_ec);
   if (streamed && streamed->engaged() && another) {
     // The slices were written while the union went on (streamed_gpkg.h): slice 0 where it carries other layers,
@@ -112,19 +112,19 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
   } else if ((own_index || csv) && another) {
     auto* plans_layer = ds->layer("ground_plans");
     const std::size_t plans = plans_layer ? static_cast<std::size_t>(plans_layer->GetFeatureCount(TRUE)) : 0;
-    writers = csv ? groundplan::cli::csv_writers(flags, layers, "ground_plans", plans, n_threads, &why_one)
-                  : groundplan::cli::gpkg_writers(flags, layers, "ground_plans", plans, n_threads, &why_one);
+    writers = csv ? output::csv_writers(flags, layers, "ground_plans", plans, n_threads, &why_one)
+                  : output::gpkg_writers(flags, layers, "ground_plans", plans, n_threads, &why_one);
     if (writers > 1) {
-      groundplan::cli::SliceWrite sw;
+      output::SliceWrite sw;
       sw.dst = ogr.dst;
       sw.flags = flags;
       sw.layers = layers;
       sw.plans = plans;
       sw.writers = writers;
       sw.progress = ogr.progress && !ogr.quiet;
-      const groundplan::cli::SliceSource source = slice_source(another, std::max(1, n_threads / writers));
-      const auto slice = csv ? groundplan::cli::write_csv_slices(sw, source, vector_translate)
-                             : groundplan::cli::write_gpkg_slices(sw, source, vector_translate);
+      const output::SliceSource source = slice_source(another, std::max(1, n_threads / writers));
+      const auto slice = csv ? output::write_csv_slices(sw, source, vector_translate)
+                             : output::write_gpkg_slices(sw, source, vector_translate);
       write_ok = slice.ok;
       usage_error = slice.usage_error;
       if (!slice.ok) std::fprintf(stderr, "groundplan: %s\n", slice.error.c_str());
@@ -136,10 +136,10 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
     w.writer = {{"writers", 1}, {"why_one", why_one}};
   }
   double index_s = 0;
-  groundplan::cli::RtreeBuild& built = w.built;
+  output::RtreeBuild& built = w.built;
   if (write_ok && own_index) {
     const auto t_index = clock::now();
-    const bool indexed = groundplan::cli::index_new_gpkg(
+    const bool indexed = output::index_new_gpkg(
         ogr.dst, static_cast<int>(groundplan::gis::thread_count(threads)), built);
     if (built.by_gdal)
       std::fprintf(stderr, "groundplan: note: packing the spatial index failed (%s); GDAL built it instead\n",

@@ -27,7 +27,7 @@ struct WriteOutcome {
   int usage_error = FALSE;
   bool own_index = false;
   double write_s = 0, index_s = 0;
-  groundplan::cli::RtreeBuild built;
+  output::RtreeBuild built;
   std::string members_note;
   nlohmann::json writer;  // --stats "writer": how many writers, and why one (gpkg_slices.h)
 };
@@ -42,7 +42,7 @@ using AnotherDataset = std::function<groundplan::driver::OGRGroundPlanDataSource
 /// written after the union: not a new GeoPackage whose index the CLI packs, an ogr2ogr option that rules slices out
 /// (gpkg_slices.h), a level of detail (its steps change the union's plans), one thread, or
 /// `--config GROUNDPLAN_WRITE_DURING_UNION NO`. Whether it is used is known once the union has begun (enough plans).
-std::unique_ptr<StreamedGpkg> stream_plans(const Ogr2ogrArgs& ogr, const gis::PipelineOptions& options,
+std::unique_ptr<output::StreamedGpkg> stream_plans(const Ogr2ogrArgs& ogr, const gis::PipelineOptions& options,
                                            std::size_t id_chars);
 
 /// Writes our dataset (taking it: closed here) through GDAL's ogr2ogr with the user's options, packs a new
@@ -50,6 +50,6 @@ std::unique_ptr<StreamedGpkg> stream_plans(const Ogr2ogrArgs& ogr, const gis::Pi
 /// `another`, where given, makes one more dataset like `ds` (the one-process result): a new GeoPackage is then
 /// written by several writers side by side (gpkg_slices.h).
 WriteOutcome write_output(driver::OGRGroundPlanDataSource* ds, const Ogr2ogrArgs& ogr, int threads,
-                          const AnotherDataset& another = {}, StreamedGpkg* streamed = nullptr);
+                          const AnotherDataset& another = {}, output::StreamedGpkg* streamed = nullptr);
 
 }  // namespace groundplan::cli
