@@ -8,7 +8,7 @@
 #include <memory>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 namespace {
 
 std::string lower(std::string s) {
@@ -108,4 +108,4 @@ SliceOutcome write_csv_slices(const SliceWrite& w, const SliceSource& source, co
   return out;
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

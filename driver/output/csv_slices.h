@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 /// True when `dst` with `format` (ogr2ogr's -f, empty: from the name) is one CSV file: the CSV driver, a name
 /// ending in .csv, not under /vsi.
@@ -29,4 +29,4 @@ int csv_writers(const std::vector<std::string>& flags, const std::vector<std::st
 /// is left under `w.dst` nor beside it.
 SliceOutcome write_csv_slices(const SliceWrite& w, const SliceSource& source, const Translate& translate);
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

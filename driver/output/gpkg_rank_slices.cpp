@@ -13,7 +13,7 @@
 #include <sstream>
 #include <unistd.h>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -205,4 +205,4 @@ RankGpkgOutcome write_gpkg_from_every_rank(gis::TileExchange& ex, const RankGpkg
   return out;
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 /// FIDs first..last (1-based, inclusive) that a rank holds of one layer.
 struct FidRun {
@@ -59,4 +59,4 @@ RankGpkgOutcome write_gpkg_from_every_rank(gis::TileExchange& ex, const RankGpkg
                                            const std::function<GDALDatasetH()>& dataset, const Translate& translate,
                                            const std::function<void()>& after_slice);
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

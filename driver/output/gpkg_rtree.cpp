@@ -33,7 +33,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 namespace {
 
 using sqlite::Db;
@@ -464,4 +464,4 @@ bool index_new_gpkg(const std::string& path, int threads, RtreeBuild& built, boo
   return CPLGetLastErrorType() < CE_Failure && gpkg_unindexed_tables(path).empty();
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 /// The feature tables of the GeoPackage at `path` that have a geometry column and no spatial index;
 /// empty when the file does not exist or is not a GeoPackage.
@@ -39,4 +39,4 @@ RtreeBuild build_gpkg_rtrees(const std::string& path, int threads);
 /// table is left without an index.
 bool index_new_gpkg(const std::string& path, int threads, RtreeBuild& built, bool packed = true);
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

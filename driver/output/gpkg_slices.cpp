@@ -13,7 +13,7 @@
 #include <thread>
 #include <unistd.h>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 namespace {
 
 // Plans a writer at least: below this, a second GDAL writer costs more than it saves.
@@ -252,4 +252,4 @@ SliceOutcome write_gpkg_slices(const SliceWrite& w, const SliceSource& source, c
   return out;
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 /// SQLite keeps process-wide memory statistics behind one global mutex, taken by every allocation of every
 /// connection: writers side by side wait on it. Turns them off; call before SQLite is first used (first
@@ -126,4 +126,4 @@ std::size_t slice_start(std::size_t plans, int k, int writers);
 /// written in slices); 1 and `why_one` when fewer than two.
 int writers_for(std::size_t plans, int threads, std::string* why_one);
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

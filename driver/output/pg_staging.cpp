@@ -11,7 +11,7 @@
 #include <chrono>
 #include <ctime>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 std::string gdal_error(const std::string& fallback) {
   const char* m = CPLGetLastErrorMsg();
@@ -214,4 +214,4 @@ std::string drop_staging_schema(const PgStaging& s, const CPLStringList& open_op
   return c.exec("DROP SCHEMA IF EXISTS " + quoted_identifier(s.schema) + " CASCADE");
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 /// GDAL's last error message, or `fallback` when there is none (also used by rank_writes.cpp).
 std::string gdal_error(const std::string& fallback);
@@ -62,4 +62,4 @@ std::string drop_staging_schema(const PgStaging& s, const CPLStringList& open_op
 /// `name` as a PostgreSQL identifier in double quotes.
 std::string quoted_identifier(const std::string& name);
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -13,7 +13,7 @@
 #include <optional>
 #include <set>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 namespace {
 
 
@@ -30,7 +30,8 @@ std::string failures(const std::vector<std::string>& texts) {
 }
 
 /// GDAL's ogr2ogr from `src` into `dst` (a name, or an open dataset `dst_ds` to add to); empty or why it failed.
-std::string translate(const std::string& dst, GDALDatasetH dst_ds, GDALDataset* src, const std::vector<std::string>& args) {
+std::string ogr2ogr_into(const std::string& dst, GDALDatasetH dst_ds, GDALDataset* src,
+                         const std::vector<std::string>& args) {
   CPLStringList argv;
   for (const std::string& a : args) argv.AddString(a.c_str());
   GDALVectorTranslateOptions* vt = GDALVectorTranslateOptionsNew(argv.List(), nullptr);
@@ -198,7 +199,7 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   }
   if (ex.rank() == 0)
     created = !setup.create ? std::string("nothing to write")
-                            : translate(staging ? staging->staged_dst() : setup.dst, nullptr, empty_layers,
+                            : ogr2ogr_into(staging ? staging->staged_dst() : setup.dst, nullptr, empty_layers,
                                         setup.options);
   GDALClose(GDALDataset::ToHandle(empty_layers));
   // Only a datasource seen before the run tells what it made; one that could not be opened is left alone.
@@ -248,7 +249,7 @@ RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, 
   } else {
     in_transaction = true;
     HeldTransaction held(GDALDataset::FromHandle(dst));
-    wrote = translate(into, GDALDataset::ToHandle(&held), mine, append_options(setup.options, own_ids));
+    wrote = ogr2ogr_into(into, GDALDataset::ToHandle(&held), mine, append_options(setup.options, own_ids));
   }
   GDALClose(GDALDataset::ToHandle(mine));
   // A rank that throws here (a fault, or the test hook) is a rank that failed to write: every rank rolls back.
@@ -324,4 +325,4 @@ std::vector<std::string> gather_text(gis::TileExchange& ex, const std::string& t
   return out;
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

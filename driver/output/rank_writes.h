@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 /// True for an output that every rank writes itself: OGR's PostgreSQL driver (-f PostgreSQL, or a PG: name
 /// without -f). Files keep rank 0 as their only writer.
@@ -67,4 +67,4 @@ struct RankWrite {
 RankWrite write_from_every_rank(gis::TileExchange& ex, const TableSetup& setup, GDALDataset* mine,
                                 GDALDataset* empty_layers, const std::function<void()>& before_commit);
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace groundplan::cli::sqlite {
+namespace groundplan::output::sqlite {
 
 struct Failure : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -85,4 +85,4 @@ inline std::string lit(const std::string& text) {
   return out + "'";
 }
 
-}  // namespace groundplan::cli::sqlite
+}  // namespace groundplan::output::sqlite

@@ -8,7 +8,7 @@
 
 #include <unistd.h>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 namespace fs = std::filesystem;
 
@@ -45,4 +45,4 @@ void StagedOutput::commit() {
   stage_.clear();
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

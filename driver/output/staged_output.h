@@ -5,7 +5,7 @@
 // no dataset under the name asked for, only `.groundplan-partial-PID/` (removed on an orderly failure).
 #include <string>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 class StagedOutput {
  public:
@@ -25,4 +25,4 @@ class StagedOutput {
   std::string dst_, path_, stage_, parent_;
 };
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -9,7 +9,7 @@
 #include <exception>
 #include <memory>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 namespace {
 
 // Plans a slice at least: below this a slice's own ogr2ogr (a file, its tables) costs more than it saves.
@@ -267,4 +267,4 @@ std::size_t StreamedGpkg::slices_before_end() const {
   return early_;
 }
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -27,7 +27,7 @@
 #include <thread>
 #include <vector>
 
-namespace groundplan::cli {
+namespace groundplan::output {
 
 class StreamedGpkg final : public PlanFeed {
  public:
@@ -97,4 +97,4 @@ class StreamedGpkg final : public PlanFeed {
   std::vector<std::thread> threads_;
 };
 
-}  // namespace groundplan::cli
+}  // namespace groundplan::output

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The GeoPackage spatial index the CLI packs itself (issue 14, driver/cli/gpkg_rtree.h) is the one GDAL's
+"""The GeoPackage spatial index the CLI packs itself (issue 14, driver/output/gpkg_rtree.h) is the one GDAL's
 own writer makes, seen from any reader: the same schema (tables, triggers, extension row, word for word),
 the same index entries (boxes rounded to float as SQLite rounds them), a tree SQLite's rtreecheck()
 accepts, the same answers to window queries, and triggers that keep it right when the file is edited."""

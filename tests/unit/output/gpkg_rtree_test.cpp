@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The GeoPackage spatial index the CLI packs (driver/cli/gpkg_rtree.h), on files written here through
+// The GeoPackage spatial index the CLI packs (driver/output/gpkg_rtree.h), on files written here through
 // GDAL: every non-empty feature's box in the tree, rounded outwards to float, a tree SQLite's rtreecheck
 // accepts; a geometry it cannot read leaves no half-built index behind; GDAL's own way as the fallback.
 // (tests/e2e/test_gpkg_index.py compares the CLI's output with GDAL's own index on real samples.)
@@ -128,12 +128,12 @@ TEST(GpkgRtree, PackedIndexHoldsEveryNonEmptyBoxRoundedOutwards) {
   test::TempDir dir("gpkg_rtree");
   const std::string path = (dir.path / "parts.gpkg").string();
   const std::vector<Box> boxes = write_gpkg(path, 5000);  // ~100 leaves: three levels of 51-cell nodes
-  ASSERT_EQ(cli::gpkg_unindexed_tables(path), std::vector<std::string>{"parts"});
-  const cli::RtreeBuild built = cli::build_gpkg_rtrees(path, 3);
+  ASSERT_EQ(output::gpkg_unindexed_tables(path), std::vector<std::string>{"parts"});
+  const output::RtreeBuild built = output::build_gpkg_rtrees(path, 3);
   ASSERT_EQ(built.error, "");
   EXPECT_EQ(built.tables, 1u);
   EXPECT_EQ(built.entries, boxes.size());
-  EXPECT_TRUE(cli::gpkg_unindexed_tables(path).empty());
+  EXPECT_TRUE(output::gpkg_unindexed_tables(path).empty());
   expect_index_holds(path, boxes);
   // GDAL sees the index and its extension row.
   EXPECT_EQ(query(path, "SELECT count(*) FROM gpkg_extensions WHERE extension_name = 'gpkg_rtree_index'")[0][0], 1.0);
@@ -146,7 +146,7 @@ TEST(GpkgRtree, EntriesInWholeBatchesAndASingleOne) {
     test::TempDir dir("gpkg_rtree");
     const std::string path = (dir.path / "parts.gpkg").string();
     const std::vector<Box> boxes = write_gpkg(path, n);
-    const cli::RtreeBuild built = cli::build_gpkg_rtrees(path, 2);
+    const output::RtreeBuild built = output::build_gpkg_rtrees(path, 2);
     ASSERT_EQ(built.error, "") << n;
     EXPECT_EQ(built.entries, boxes.size()) << n;
     expect_index_holds(path, boxes);
@@ -159,9 +159,9 @@ TEST(GpkgRtree, GdalsOwnWayGivesTheSameEntries) {
   const std::string a = (dir.path / "a.gpkg").string(), b = (dir.path / "b.gpkg").string();
   const std::vector<Box> boxes = write_gpkg(a, 700);
   write_gpkg(b, 700);
-  cli::RtreeBuild packed, gdal;
-  ASSERT_TRUE(cli::index_new_gpkg(a, 2, packed));
-  ASSERT_TRUE(cli::index_new_gpkg(b, 2, gdal, /*packed=*/false));
+  output::RtreeBuild packed, gdal;
+  ASSERT_TRUE(output::index_new_gpkg(a, 2, packed));
+  ASSERT_TRUE(output::index_new_gpkg(b, 2, gdal, /*packed=*/false));
   EXPECT_FALSE(packed.by_gdal);
   EXPECT_TRUE(gdal.by_gdal);
   const std::string sql = "SELECT id, minx, maxx, miny, maxy FROM rtree_parts_geom ORDER BY id";
@@ -179,17 +179,17 @@ TEST(GpkgRtree, AFailureLeavesNoHalfBuiltIndex) {
   const std::string bad_blob = (dir.path / "bad_blob.gpkg").string();
   write_gpkg(bad_blob, 300);
   query(bad_blob, "UPDATE parts SET geom = X'0001020304' WHERE fid = 123", /*update=*/true);
-  cli::RtreeBuild built = cli::build_gpkg_rtrees(bad_blob, 2);
+  output::RtreeBuild built = output::build_gpkg_rtrees(bad_blob, 2);
   EXPECT_NE(built.error.find("feature 123"), std::string::npos) << built.error;
   EXPECT_EQ(built.tables, 0u);
-  EXPECT_EQ(cli::gpkg_unindexed_tables(bad_blob), std::vector<std::string>{"parts"});
+  EXPECT_EQ(output::gpkg_unindexed_tables(bad_blob), std::vector<std::string>{"parts"});
   EXPECT_EQ(rtree_tables(bad_blob), 0.0);
   // A stale trigger of the index's name: the failure comes after the tree is written, and the
   // transaction takes all of it back (the R-tree tables and the extension row too).
   const std::string stale = (dir.path / "stale_trigger.gpkg").string();
   write_gpkg(stale, 300);
   query(stale, "CREATE TRIGGER rtree_parts_geom_delete AFTER DELETE ON parts BEGIN SELECT 1; END", /*update=*/true);
-  built = cli::build_gpkg_rtrees(stale, 2);
+  built = output::build_gpkg_rtrees(stale, 2);
   EXPECT_NE(built.error.find("rtree_parts_geom_delete"), std::string::npos) << built.error;
   EXPECT_EQ(built.tables, 0u);
   EXPECT_EQ(rtree_tables(stale), 0.0);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The GeoPackage written while the union goes on (driver/cli/streamed_gpkg.h), fed here by hand: blocks told in
+// The GeoPackage written while the union goes on (driver/output/streamed_gpkg.h), fed here by hand: blocks told in
 // any order from several threads (empty blocks, blocks of several plans, slices that wait for a late block) give
 // the file one ogr2ogr writes from the whole result, row for row; a union that stops leaves no file; few plans
 // leave the write to the caller. (tests/e2e/test_gpkg_writers.py runs it through the CLI and the real union.)
@@ -121,8 +121,8 @@ std::vector<std::string> rows(const std::string& path, const std::string& table)
   return out;
 }
 
-cli::StreamedGpkg::Setup setup(const std::string& dst, std::vector<std::string> layers) {
-  cli::StreamedGpkg::Setup s;
+output::StreamedGpkg::Setup setup(const std::string& dst, std::vector<std::string> layers) {
+  output::StreamedGpkg::Setup s;
   s.write.dst = dst;
   s.write.flags = {"-f", "GPKG", "-lco", "SPATIAL_INDEX=NO"};
   s.write.layers = std::move(layers);
@@ -157,11 +157,11 @@ TEST(StreamedGpkg, BlocksInAnyOrderGiveTheFileOfOneWriter) {
   const std::string ref = reference(dir, f, {"ground_plans"});
   for (unsigned seed : {1u, 2u}) {
     const std::string dst = (dir.path / ("s" + std::to_string(seed) + ".gpkg")).string();
-    cli::StreamedGpkg w(setup(dst, {"ground_plans"}));
+    output::StreamedGpkg w(setup(dst, {"ground_plans"}));
     ASSERT_EQ(w.engage(*f.result), &w);
     feed_shuffled(w, f, seed);
     ASSERT_TRUE(w.engaged());
-    const cli::SliceOutcome out = w.finish({});
+    const output::SliceOutcome out = w.finish({});
     ASSERT_TRUE(out.ok) << out.error;
     EXPECT_GE(w.writers(), 2);
     EXPECT_GE(w.slices(), 3u);  // several slices: the appending ran beside the writing
@@ -179,15 +179,15 @@ TEST(StreamedGpkg, OtherLayersGoWithSliceZeroAfterTheUnion) {
   const std::vector<std::string> layers = {"ground_plans", "problems"};
   const std::string ref = reference(dir, f, layers);
   const std::string dst = (dir.path / "late.gpkg").string();
-  cli::StreamedGpkg w(setup(dst, layers));
+  output::StreamedGpkg w(setup(dst, layers));
   w.engage(*f.result);
   feed_shuffled(w, f, 3);
-  const cli::SliceSource slice0 = [&](std::size_t first, std::size_t last) -> GDALDatasetH {
+  const output::SliceSource slice0 = [&](std::size_t first, std::size_t last) -> GDALDatasetH {
     auto* ds = new driver::OGRGroundPlanDataSource("GROUNDPLAN:grid", f.result, 0, 1);
     ds->layer("ground_plans")->restrict_to(first, last);
     return GDALDataset::ToHandle(ds);
   };
-  const cli::SliceOutcome out = w.finish(slice0);
+  const output::SliceOutcome out = w.finish(slice0);
   ASSERT_TRUE(out.ok) << out.error;
   EXPECT_EQ(rows(dst, "ground_plans"), rows(ref, "ground_plans"));
   EXPECT_EQ(rows(dst, "problems"), rows(ref, "problems"));
@@ -200,12 +200,12 @@ TEST(StreamedGpkg, AUnionThatStopsLeavesNoFile) {
   const Fed f = make_fed(30000);
   const std::string dst = (dir.path / "stopped.gpkg").string();
   {
-    cli::StreamedGpkg w(setup(dst, {"ground_plans"}));
+    output::StreamedGpkg w(setup(dst, {"ground_plans"}));
     w.engage(*f.result);
     w.begin(f.blocks.size());
     for (std::size_t b = 0; b < f.blocks.size() / 2; ++b) w.block_done(b, f.blocks[b]);  // slices get written
     w.end(false);
-    const cli::SliceOutcome out = w.finish({});
+    const output::SliceOutcome out = w.finish({});
     EXPECT_FALSE(out.ok);
     EXPECT_NE(out.error.find("union stopped"), std::string::npos) << out.error;
   }
@@ -217,7 +217,7 @@ TEST(StreamedGpkg, FewPlansAreLeftToTheCaller) {
   test::TempDir dir("streamed_gpkg");
   const Fed f = make_fed(3000);
   const std::string dst = (dir.path / "few.gpkg").string();
-  cli::StreamedGpkg w(setup(dst, {"ground_plans"}));
+  output::StreamedGpkg w(setup(dst, {"ground_plans"}));
   w.engage(*f.result);
   feed_shuffled(w, f, 4);
   EXPECT_FALSE(w.engaged());
