@@ -8,6 +8,9 @@
 #include "csv_slices.h"
 #include "gpkg_slices.h"
 #include "preview.h"
+#ifdef GROUNDPLAN_WITH_JEMALLOC
+#include <jemalloc/jemalloc.h>
+#endif
 #ifdef GROUNDPLAN_WITH_MPI
 #include "gpkg_rank_slices.h"
 #include "mpi_exchange.h"
@@ -305,6 +308,17 @@ std::string lod_summary(const groundplan::LodParams& p, const groundplan::LodSta
   }
   return out;
 }
+
+#ifdef GROUNDPLAN_WITH_JEMALLOC
+/// The allocator's own version, asked of it: also what keeps the program linked to it (mallctl is jemalloc's).
+std::string jemalloc_version() {
+  const char* v = nullptr;
+  std::size_t n = sizeof v;
+  if (mallctl("version", &v, &n, nullptr, 0) != 0 || !v) return "?";
+  const std::string s(v);
+  return s.substr(0, s.find('-'));
+}
+#endif
 
 using clock = std::chrono::steady_clock;
 
@@ -888,6 +902,9 @@ int run(int argc, char** argv, Ranks* ranks) {
                                         GDALVersionInfo("RELEASE_NAME") +
 #ifdef GROUNDPLAN_WITH_MPI
                                         ", MPI: " + groundplan::cli::mpi_version() +
+#endif
+#ifdef GROUNDPLAN_WITH_JEMALLOC
+                                        ", jemalloc " + jemalloc_version() +
 #endif
                                         ")");
   double resolution = 0;
