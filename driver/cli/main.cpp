@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <thread>
 #include <cctype>
 #include <chrono>
 #include <filesystem>
@@ -62,6 +63,23 @@ int rank_count(Ranks* ranks) {
   (void)ranks;
   return 1;
 #endif
+}
+
+/// Threads of a rank without --threads or GDAL_NUM_THREADS (0: all cores): under mpirun, the cores this rank may
+/// use shared with the job's other ranks on its host, so that N ranks on one host do not start N x cores threads (16
+/// ranks x 2 threads on 32 cores: 3.7 s where 16 x 1 took 4.7, tests/bench/RESULTS.md). A rank the launcher bound to
+/// fewer cores than the host has (--bind-to core, --map-by ...:pe=n) takes those.
+int default_threads(Ranks* ranks) {
+#ifdef GROUNDPLAN_WITH_MPI
+  if (rank_count(ranks) > 1) {
+    const int usable = static_cast<int>(groundplan::gis::thread_count(0));  // the affinity mask's cores
+    const int host = static_cast<int>(std::thread::hardware_concurrency());
+    return usable < host ? usable : std::max(1, usable / ranks->ranks_on_host());
+  }
+#else
+  (void)ranks;
+#endif
+  return 0;
 }
 
 using groundplan::gis::PipelineOptions;
@@ -1023,11 +1041,14 @@ int run(int argc, char** argv, Ranks* ranks) {
   if (o_min_area->count()) options.detail.min_area_m2 = lod_flags.min_area_m2;
   if (o_simplify->count()) options.detail.simplify_m = lod_flags.simplify_m;
 
-  // --threads, else GDAL's GDAL_NUM_THREADS (--config GDAL_NUM_THREADS 4, or the environment), else all cores.
+  // --threads, else GDAL's GDAL_NUM_THREADS (--config GDAL_NUM_THREADS 4, or the environment), else all cores
+  // (under mpirun: the host's cores shared among its ranks).
   if (o_threads->count())
     options.threads = threads;
   else if (const char* v = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))
     options.threads = groundplan::gis::threads_from_string(v, "GDAL_NUM_THREADS");
+  else
+    options.threads = default_threads(ranks);
   options.read_chunk_bytes = read_chunk_bytes;
   options.read_range_features = read_range_features;
 
