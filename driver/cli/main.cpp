@@ -1147,10 +1147,16 @@ int run(int argc, char** argv, Ranks* ranks) {
   nlohmann::json verify_json;
   if (verify) {
     const auto c = groundplan::gis::compare_with_geos(result.footprints, result.plans);
+    // The footprints themselves, checked against each building's lowest faces while reading
+    // (core/src/footprint/ground_check.h): plans right for wrong footprints are no MATCH.
+    std::size_t missing_ground = 0;
+    std::string first_missing;
+    for (const auto& p : result.problems)
+      if (p.code == "FOOTPRINT_MISSES_GROUND" && missing_ground++ == 0) first_missing = p.source_id + ": " + p.reason;
     // With a level of detail the plans differ from the exact union on purpose: what must hold is
     // validity and no overlap; the difference is reported.
     const bool lod = options.detail.any();
-    const bool ok = lod ? c.invalid_ours == 0 && c.overlapping_ours == 0 : c.matches();
+    const bool ok = (lod ? c.invalid_ours == 0 && c.overlapping_ours == 0 : c.matches()) && missing_ground == 0;
     if (lod)
       std::printf("groundplan: verify (level of detail on): %s: %zu invalid plans, %zu overlapping pairs; against "
                   "the exact GEOS UnaryUnion: area %.6f m2 vs %.6f m2, symmetric difference %.6g m2 (%.3g%%), %zu vs "
@@ -1159,12 +1165,27 @@ int run(int argc, char** argv, Ranks* ranks) {
                   c.symdiff_area, c.area_geos > 0 ? 100 * c.symdiff_area / c.area_geos : 0.0, c.polygons_ours,
                   c.polygons_geos, c.holes_ours, c.holes_geos);
     else
-      std::printf("groundplan: verify against GEOS UnaryUnion: %s: %s\n", c.matches() ? "MATCH" : "MISMATCH",
-                  c.summary().c_str());
-    verify_json = {{"match", c.matches()}, {"level_of_detail", lod}, {"valid_and_disjoint", c.invalid_ours == 0 && c.overlapping_ours == 0},        {"symdiff_area_m2", c.symdiff_area}, {"area_m2", c.area_ours},
+      std::printf("groundplan: verify against GEOS UnaryUnion, differences decided exactly against the footprints: "
+                  "%s (%s)\n",
+                  c.verdict_line().c_str(), c.summary().c_str());
+    if (missing_ground)
+      std::printf("groundplan: verify: MISMATCH: %zu footprint%s leave%s out ground the building stands on "
+                  "(FOOTPRINT_MISSES_GROUND; first %s)\n",
+                  missing_ground, missing_ground == 1 ? "" : "s", missing_ground == 1 ? "s" : "", first_missing.c_str());
+    const char* verdict = lod ? (ok ? "valid" : "invalid")
+                          : missing_ground ? "mismatch"
+                          : c.verdict() == groundplan::gis::GeosComparison::Verdict::Match ? "match"
+                          : c.verdict() == groundplan::gis::GeosComparison::Verdict::MatchGeosDiffers
+                              ? "match_geos_differs"
+                              : "mismatch";
+    verify_json = {{"match", c.matches() && missing_ground == 0}, {"verdict", verdict}, {"footprints_missing_ground", missing_ground}, {"level_of_detail", lod}, {"valid_and_disjoint", c.invalid_ours == 0 && c.overlapping_ours == 0},        {"symdiff_area_m2", c.symdiff_area}, {"area_m2", c.area_ours},
                    {"area_geos_m2", c.area_geos}, {"polygons", c.polygons_ours},      {"polygons_geos", c.polygons_geos},
                    {"holes", c.holes_ours},       {"holes_geos", c.holes_geos},        {"invalid", c.invalid_ours},
-                   {"holes_geos_artifacts", c.holes_geos_artifacts}};
+                   {"holes_geos_artifacts", c.holes_geos_artifacts}, {"holes_geos_dropped", c.holes_geos_dropped},
+                   {"places_geos_wrong", c.places_geos_wrong},     {"largest_geos_wrong_m2", c.largest_geos_wrong_m2},
+                   {"places_ours_wrong", c.places_ours_wrong},     {"largest_ours_wrong_m2", c.largest_ours_wrong_m2},
+                   {"places_ours_below_pitch", c.places_ours_below_pitch}, {"places_undecided", c.places_undecided}};
+    if (!c.first_ours_wrong.empty()) verify_json["first_ours_wrong"] = c.first_ours_wrong;
     if (!ok) rc = 3;
   }
   if (!stats_path.empty() && !write_stats(stats_path, result, write_s, index_s, total_s, cpu_s, verify ? &verify_json : nullptr,
