@@ -495,6 +495,7 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
                                     std::string& why) {
   const std::size_t n = plan.ranges.size();
   std::vector<ReadInfo> infos(n);
+  for (ReadInfo& info : infos) info.format = InputFormat::CityGml;  // what read_any says before its first mesh
   std::vector<CityGmlChunkWatch> watches(n);
   CityGmlOptions citygml;
   citygml.lod = options.lod;
@@ -593,6 +594,7 @@ std::string guess_working_definition(const std::string& file, const PipelineOpti
       citygml.lod = options.lod;
       citygml.dom_max_bytes = citygml::in_memory_bytes();
       CityGmlChunkWatch watch;
+      info.format = InputFormat::CityGml;  // as read_chunks and read_any say
       read_citygml_chunk(file, plan, 0, citygml, on_mesh, part.problems, info.citygml, watch);
     } else {
       read_any(file, whole_read_options(options, context), on_mesh, part.problems, info);
