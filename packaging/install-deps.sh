@@ -21,6 +21,8 @@ packages=(
   libcli11-dev nlohmann-json3-dev libtbb-dev
   # GeoPackage spatial index packed by the CLI (GDAL's own SQLite)
   libsqlite3-dev
+  # the CLI's allocator: jemalloc (fewer CPU seconds than glibc's malloc on many threads; optional, GROUNDPLAN_JEMALLOC)
+  libjemalloc-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev python3-pytest
   # the GeoPandas/Shapely baseline of the OGR-input benchmark (issue 22, tests/bench/ogr_input_bench.sh)

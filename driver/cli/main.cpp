@@ -18,6 +18,9 @@
 #include <cpl_conv.h>
 #include <cpl_string.h>
 #include <gdal.h>
+#ifdef GROUNDPLAN_WITH_JEMALLOC
+#include <jemalloc/jemalloc.h>
+#endif
 
 #include <cstdio>
 #include <iostream>
@@ -28,6 +31,17 @@
 
 namespace groundplan::cli {
 namespace {
+
+#ifdef GROUNDPLAN_WITH_JEMALLOC
+/// The allocator's own version, asked of it: also what keeps the program linked to it (mallctl is jemalloc's).
+std::string jemalloc_version() {
+  const char* v = nullptr;
+  std::size_t n = sizeof v;
+  if (mallctl("version", &v, &n, nullptr, 0) != 0 || !v) return "?";
+  const std::string s(v);
+  return s.substr(0, s.find('-'));
+}
+#endif
 
 /// What the command line asks for.
 struct CommandLine {
@@ -42,7 +56,7 @@ struct CommandLine {
 /// destination, the source, the layers and GDAL's ogr2ogr options). An exit code where the command line is answered
 /// already (--help, --version, --formats, a usage error); nullopt where there is a run to make. Throws
 /// InvalidArgument on a bad value.
-std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
+std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl, Ranks* ranks) {
   CLI::App app{
       "groundplan: ground plans (the exact union of building footprints) from 3D city models.\n"
       "Usage: groundplan [groundplan options] [ogr2ogr options] dst_datasource src_file_or_folder [layer ...]\n"
@@ -55,6 +69,9 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
                                         GDALVersionInfo("RELEASE_NAME") +
 #ifdef GROUNDPLAN_WITH_MPI
                                         ", MPI: " + groundplan::cli::mpi_version() +
+#endif
+#ifdef GROUNDPLAN_WITH_JEMALLOC
+                                        ", jemalloc " + jemalloc_version() +
 #endif
                                         ")");
   double resolution = 0;
@@ -176,11 +193,14 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
   if (o_min_area->count()) options.detail.min_area_m2 = lod_flags.min_area_m2;
   if (o_simplify->count()) options.detail.simplify_m = lod_flags.simplify_m;
 
-  // --threads, else GDAL's GDAL_NUM_THREADS (--config GDAL_NUM_THREADS 4, or the environment), else all cores.
+  // --threads, else GDAL's GDAL_NUM_THREADS (--config GDAL_NUM_THREADS 4, or the environment), else all cores
+  // (under mpirun: the host's cores shared among its ranks).
   if (o_threads->count())
     options.threads = threads;
   else if (const char* v = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr))
     options.threads = groundplan::gis::threads_from_string(v, "GDAL_NUM_THREADS");
+  else
+    options.threads = default_threads(ranks);
   options.read_chunk_bytes = read_chunk_bytes;
   options.read_range_features = read_range_features;
   return std::nullopt;
@@ -189,7 +209,7 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl) {
 /// The command: its arguments, then the run, tiled or in one process.
 int run(int argc, char** argv, Ranks* ranks) {
   CommandLine cl;
-  if (const std::optional<int> answered = parse_command_line(argc, argv, cl)) return *answered;
+  if (const std::optional<int> answered = parse_command_line(argc, argv, cl, ranks)) return *answered;
   if (takes_tiled_run(cl.tiles, cl.options, cl.ogr, cl.verify, !cl.preview_path.empty(), rank_count(ranks)))
     return run_tiled(cl.options, cl.ogr, cl.stats_path, terminal_progress(cl.ogr), ranks);
   return run_one_process(cl.options, cl.ogr, cl.stats_path, cl.preview_path, cl.verify);

@@ -24,6 +24,8 @@ class MpiExchange final : public gis::TileExchange {
   ~MpiExchange() override;
   int rank() const override { return rank_; }
   int size() const override { return size_; }
+  /// The ranks of the job on this rank's host (this one included): they share its cores.
+  int ranks_on_host() const { return host_ranks_; }
   std::vector<char> allgather(const std::vector<char>& mine, std::vector<std::uint64_t>* sizes = nullptr) override;
   void send(int to, const std::vector<char>& bytes) override;
   std::vector<char> receive(int from) override;
@@ -46,7 +48,7 @@ class MpiExchange final : public gis::TileExchange {
   bool test_pretends(const std::string& point) const;
 
  private:
-  int rank_ = 0, size_ = 1;
+  int rank_ = 0, size_ = 1, host_ranks_ = 1;
   int calls_ = 0;  // for GROUNDPLAN_MPI_TEST_FAIL
   // tell_progress: words sent and not known to be delivered yet (a word's buffer lives until then)
   std::deque<std::pair<std::array<std::uint64_t, 2>, MPI_Request>> told_;

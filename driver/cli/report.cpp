@@ -164,7 +164,7 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   for (const auto& [file, why] : rs.xml_streamed) streamed.push_back({{"file", file}, {"why", why}});
   j["reading"] = {{"threads", rs.threads}, {"files", rs.files},       {"bytes", rs.bytes},
                   {"files_chunked", rs.files_chunked}, {"chunks", rs.chunks}, {"read_whole", whole},
-                  {"xml_streamed", streamed}};
+                  {"xml_streamed", streamed}, {"crs_guessed", rs.crs_guessed}};
   j["raster_backend"] = result.raster_backend;
   if (written && written->own_index && written->ok)  // the GeoPackage spatial index packed by the CLI (gpkg_rtree.h)
     j["spatial_index"] = spatial_index_json(written->built);
@@ -192,7 +192,8 @@ bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::Til
                     {"union", r.timings.union_s}, {"write", write_s}, {"spatial_index", index_s},
                     {"total", total_s}, {"cpu", cpu_s}};
   j["reading"] = {{"threads", r.reading.threads}, {"files", r.reading.files}, {"bytes", r.reading.bytes},
-                  {"files_chunked", r.reading.files_chunked}, {"chunks", r.reading.chunks}};
+                  {"files_chunked", r.reading.files_chunked}, {"chunks", r.reading.chunks},
+                  {"crs_guessed", r.reading.crs_guessed}};
   j["tiles"] = {{"tiles", t.tiles}, {"tile_plans", t.tile_plans}, {"final_at_once", t.final_plans},
                 {"seam_plans", t.seam_plans}, {"seam_footprints", t.seam_footprints},
                 {"plans_from_seams", t.reduced_plans}, {"max_tile_footprints", t.max_tile_footprints},

@@ -396,3 +396,17 @@ def test_a_rank_failing_in_its_gpkg_slice_leaves_no_destination(tmp_path, city, 
     else:
         assert "rank 2" in p.stderr and "signal 9" in p.stderr, p.stderr
         assert all(n.startswith(".groundplan-partial-") for n in left), left
+
+
+def test_ranks_share_the_hosts_cores_without_threads(tmp_path, city):
+    """Without --threads each rank takes its share of the host's cores (the ranks on one host divide them), not
+    all of them: N ranks do not start N x cores threads. --threads still sets it. Unbound ranks (--bind-to none), so
+    that every rank sees every core."""
+    folder = city[0]
+    usable, host = len(os.sched_getaffinity(0)), os.cpu_count()
+    expected = usable if usable < host else max(1, usable // 2)
+    for flags, threads in (([], expected), (["--threads", "3"], 3)):
+        stats = tmp_path / f"s{len(flags)}.json"
+        run([*mpirun(2), "--bind-to", "none", BIN, "-q", "--stats", stats, *flags, "--tiles", "on", "-f", "GPKG",
+             tmp_path / f"o{len(flags)}.gpkg", folder])
+        assert json.loads(stats.read_text())["reading"]["threads"] == threads, flags

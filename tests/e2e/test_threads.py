@@ -8,7 +8,7 @@ import json
 import pytest
 from osgeo import gdal
 
-from conftest import BIN, SAMPLES, SHARED_DATA, THIRDPARTY_DATA, real_sample_files, run, thirdparty_data
+from conftest import BIN, LORUP, SAMPLES, SHARED_DATA, THIRDPARTY_DATA, real_sample_files, run, thirdparty_data
 
 LAYERS = ["ground_plans", "footprints", "problems", "plan_members"]
 
@@ -111,3 +111,30 @@ def test_a_zip_of_tiles_is_read_like_the_folder(tmp_path):
     # Not README.txt; not "../escape.gml" either (GDAL's /vsizip/ listing leaves out entries outside the archive)
     assert stats["reading"]["files"] == 4
     assert from_zip["ground_plans"] == from_folder["ground_plans"]
+
+
+def test_short_epsg_srsname_is_longitude_first_in_chunks_too(tmp_path):
+    """A CityGML srsName in the short form "EPSG:4326" is read longitude first (GDAL's GML convention), whether the
+    file is read whole or in chunks side by side: the chunks once took it latitude first (their reader was not told
+    the format), which put every building of such a file in another UTM zone. The Lorup tile in degrees."""
+    import re
+    from osgeo import osr
+    utm, wgs = osr.SpatialReference(), osr.SpatialReference()
+    utm.ImportFromEPSG(25832)
+    wgs.ImportFromEPSG(4326)
+    wgs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    to_degrees = osr.CoordinateTransformation(utm, wgs)
+
+    def degrees(m):
+        lon, lat, _ = to_degrees.TransformPoint(float(m.group(1)), float(m.group(2)))
+        return "%.9f %.9f %s" % (lon, lat, m.group(3))
+    text = re.sub(r"(\d{6}(?:\.\d*)?)\s+(\d{7}(?:\.\d*)?)\s+(-?\d+(?:\.\d*)?)", degrees,
+                  LORUP.read_text(encoding="utf-8"))
+    src = tmp_path / "lorup_degrees.gml"
+    src.write_text(re.sub(r'srsName="[^"]*"', 'srsName="EPSG:4326"', text), encoding="utf-8")
+    whole, whole_stats = csv_hashes(tmp_path, "whole", src, "--threads", "1", "--read-chunk-bytes", "-1")
+    cut, cut_stats = csv_hashes(tmp_path, "cut", src, "--threads", "2", "--read-chunk-bytes", "65536")
+    assert whole_stats["reading"]["chunks"] == 0 and cut_stats["reading"]["chunks"] > 1
+    assert cut == whole
+    x, y = map(float, (tmp_path / "whole" / "ground_plans.csv").read_text().split("((")[1].split(",")[0].split())
+    assert 400000 < x < 420000 and 5850000 < y < 5870000  # Lorup in UTM zone 32

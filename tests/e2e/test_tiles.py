@@ -185,3 +185,25 @@ def test_auto_keeps_the_one_process_run_where_memory_is_not_at_stake(tmp_path):
         out[name] = ((tmp_path / f"{name}.csv").read_bytes(), json.loads(s.read_text()))
     assert out["auto"][0] == out["off"][0]
     assert "tiles" not in out["auto"][1]
+
+
+@pytest.mark.parametrize("tiles", ["off", "on"])
+def test_first_tile_read_with_the_others_once_its_first_building_fixes_the_crs(tmp_path, tiles):
+    """The working CRS is taken from the first tile's first building, so the first tile is read side by side with
+    the others instead of before them (--stats reading.crs_guessed); tiles without a CRS fix none: the first is read
+    alone first, as always. Either way the plans are those of the tiles read one after the other: the tiled run's
+    tests above compare them with the one-process run."""
+    src = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
+    bare = tmp_path / "bare"
+    bare.mkdir()
+    for f in sorted(src.glob("*.gml"))[:2]:  # the same tiles without srsName: coordinates kept as written
+        text = f.read_text(encoding="utf-8")
+        (bare / f.name).write_text(text.replace('srsName="urn:ogc:def:crs,crs:EPSG:6.12:25832,crs:EPSG:6.12:5783"', ""),
+                                   encoding="utf-8")
+    for folder, guessed in ((src, True), (bare, False)):
+        stats = tmp_path / f"{folder.name}.json"
+        run([BIN, "-q", "--tiles", tiles, "--threads", "2", "--stats", stats, "-f", "CSV", "-lco", "GEOMETRY=AS_WKT",
+             tmp_path / f"{folder.name}.csv", folder])
+        s = json.loads(stats.read_text())
+        assert s["reading"]["crs_guessed"] is guessed, folder
+        assert s["counts"]["ground_plans"] > 0

@@ -361,18 +361,24 @@ void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info
   }
 }
 
-/// The whole file, one building after the other (footprints on the other cores).
-FileRead read_whole(const std::string& file, const PipelineOptions& options, const ReadContext& context,
-                    ByteProgress& bytes) {
-  FileRead out;
-  Part part;
-  ReadInfo info;
+/// What read_any is told for a whole file.
+ReadOptions whole_read_options(const PipelineOptions& options, const ReadContext& context) {
   ReadOptions read_options;
   read_options.lod = options.lod;
   read_options.lod_refinement = options.lod_refinement;
   read_options.origin = options.origin;
   read_options.ogr = options.ogr_input;
   read_options.target_srs = context.working_definition;  // KML/glTF are placed by the reader, in this CRS
+  return read_options;
+}
+
+/// The whole file, one building after the other (footprints on the other cores).
+FileRead read_whole(const std::string& file, const PipelineOptions& options, const ReadContext& context,
+                    ByteProgress& bytes) {
+  FileRead out;
+  Part part;
+  ReadInfo info;
+  ReadOptions read_options = whole_read_options(options, context);
   bool counted_bytes = false;
   read_options.on_bytes = [&](std::uint64_t n) {
     counted_bytes = true;
@@ -489,6 +495,7 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
                                     std::string& why) {
   const std::size_t n = plan.ranges.size();
   std::vector<ReadInfo> infos(n);
+  for (ReadInfo& info : infos) info.format = InputFormat::CityGml;  // what read_any says before its first mesh
   std::vector<CityGmlChunkWatch> watches(n);
   CityGmlOptions citygml;
   citygml.lod = options.lod;
@@ -566,6 +573,42 @@ std::uint64_t auto_chunk_bytes(std::uint64_t shared, std::size_t threads) {
 }
 
 }  // namespace
+
+std::string guess_working_definition(const std::string& file, const PipelineOptions& options,
+                                     const ReadContext& context) {
+  struct Decided {};  // thrown from the mesh callback: the reader stops there
+  ReadInfo info;
+  Part part;
+  Placer placer(file, options, context, info.in_working_crs, info.citygml, {}, nullptr, &info);
+  const auto on_mesh = [&](Mesh&& mesh) {
+    placer.place(mesh, part);
+    if (info.in_working_crs || (placer.frame && placer.frame->decided())) throw Decided{};
+  };
+  try {
+    CityGmlChunkPlan plan;
+    if (detect_format(file) == InputFormat::CityGml)
+      plan = plan_citygml_chunks(file, std::uint64_t{4} << 20, std::uint64_t{1} << 20);
+    if (plan.why_not.empty() && plan.ranges.size() >= 2) {
+      // Its first chunk (the file's head and first buildings), read as read_chunks reads it.
+      CityGmlOptions citygml;
+      citygml.lod = options.lod;
+      citygml.dom_max_bytes = citygml::in_memory_bytes();
+      CityGmlChunkWatch watch;
+      info.format = InputFormat::CityGml;  // as read_chunks and read_any say
+      read_citygml_chunk(file, plan, 0, citygml, on_mesh, part.problems, info.citygml, watch);
+    } else {
+      read_any(file, whole_read_options(options, context), on_mesh, part.problems, info);
+    }
+  } catch (const Decided&) {
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const std::exception&) {
+    return {};  // the reading of the file itself says what is wrong
+  }
+  if (info.in_working_crs || !placer.frame || !placer.frame->source_known() || !placer.frame->decided()) return {};
+  const WorkingCrs& crs = placer.frame->working_crs();
+  return crs.known ? crs.definition : std::string{};
+}
 
 void ByteProgress::add(std::uint64_t n) {
   const std::uint64_t done = done_.fetch_add(n, std::memory_order_relaxed) + n;

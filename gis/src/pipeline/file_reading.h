@@ -66,4 +66,12 @@ class ByteProgress {
 FileRead read_file(const std::string& file, const PipelineOptions& options, const ReadContext& context,
                    std::size_t threads, std::uint64_t shared_bytes, ByteProgress& bytes);
 
+/// The working CRS that reading `file` first (with `context`, which fixes none yet) will fix, found from its first
+/// building alone: a CityGML file's first chunk, any other file's reading stopped at its first building. Lets every
+/// file be read side by side with the first instead of after it (a folder of tiles: the first tile is no longer read
+/// alone; over MPI ranks, the others no longer wait for it). Empty when that building does not decide it (no CRS
+/// known, a reader that places the meshes itself, an unreadable start): then the first file is read before the
+/// others, as always. A guess: the caller checks it against what the first file's reading fixed (fixed_crs).
+std::string guess_working_definition(const std::string& file, const PipelineOptions& options, const ReadContext& context);
+
 }  // namespace groundplan::gis::detail

@@ -24,4 +24,12 @@ std::uint64_t total_bytes(const std::vector<std::string>& files);
 void merge_file(FileRead&& r, const std::string& file, ReadContext& context, PipelineResult& result,
                 std::size_t& files_failed, std::string& first_failure);
 
+/// merge_file's CRS part: what one file's reading, in file order, fixes of the working CRS (context) and of the
+/// result's CRS.
+void fix_crs(const FileRead& r, const std::string& file, ReadContext& context, PipelineResult& result);
+
+/// Whether the first file's reading fixed the working CRS that guess_working_definition guessed from it, where the
+/// later files were read side by side with it in that CRS.
+bool guess_held(const FileRead& first, const std::string& file, const ReadContext& before, const std::string& guess);
+
 }  // namespace groundplan::gis::detail

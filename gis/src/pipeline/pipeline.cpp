@@ -235,6 +235,18 @@ void detail::merge_file(detail::FileRead&& r, const std::string& file, detail::R
     ++files_failed;
     if (first_failure.empty()) first_failure = r.failure;
   }
+  detail::fix_crs(r, file, context, result);
+  if (r.chunks) {
+    ++result.reading.files_chunked;
+    result.reading.chunks += r.chunks;
+  } else if (!r.whole_reason.empty()) {
+    result.reading.read_whole.emplace_back(file, r.whole_reason);
+  }
+  if (!r.xml_streamed_why.empty()) result.reading.xml_streamed.emplace_back(file, r.xml_streamed_why);
+}
+
+void detail::fix_crs(const detail::FileRead& r, const std::string& file, detail::ReadContext& context,
+                     PipelineResult& result) {
   auto take = [&](const WorkingCrs& crs) {
     if (!result.crs_wkt.empty() || !crs.known || !context.unknown_frame_file.empty()) return;
     result.crs_wkt = crs.wkt;
@@ -248,13 +260,14 @@ void detail::merge_file(detail::FileRead&& r, const std::string& file, detail::R
       context.unknown_frame_file.empty())
     context.unknown_frame_file = file;
   if (r.has_frame) take(r.frame_crs);
-  if (r.chunks) {
-    ++result.reading.files_chunked;
-    result.reading.chunks += r.chunks;
-  } else if (!r.whole_reason.empty()) {
-    result.reading.read_whole.emplace_back(file, r.whole_reason);
-  }
-  if (!r.xml_streamed_why.empty()) result.reading.xml_streamed.emplace_back(file, r.xml_streamed_why);
+}
+
+bool detail::guess_held(const detail::FileRead& first, const std::string& file, const detail::ReadContext& before,
+                        const std::string& guess) {
+  detail::ReadContext after = before;
+  PipelineResult crs_only;
+  fix_crs(first, file, after, crs_only);
+  return after.working_definition == guess && after.unknown_frame_file.empty();
 }
 
 namespace {
@@ -298,10 +311,17 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   detail::ByteProgress bytes(progress.sub(0, 0.6), result.reading.bytes);
   progress.report(0, "reading");
   std::size_t fi = 0;
-  for (; fi < files.size() && context.working_definition.empty(); ++fi)
-    detail::merge_file(detail::read_file(files[fi], options, context, threads, 0, bytes), files[fi], context, result,
-               files_failed, first_failure);
-  if (fi < files.size()) {
+  // The working CRS guessed from the first file's first building: then the first file is read side by side with
+  // the others (in the context it is read in alone), not before them.
+  std::string guess = context.working_definition.empty() && files.size() > 1
+                          ? detail::guess_working_definition(files[0], options, context)
+                          : std::string{};
+  std::vector<detail::FileRead> reads;
+  for (;;) {
+    for (; guess.empty() && fi < files.size() && context.working_definition.empty(); ++fi)
+      detail::merge_file(detail::read_file(files[fi], options, context, threads, 0, bytes), files[fi], context, result,
+                         files_failed, first_failure);
+    if (fi == files.size()) break;
     // Largest first, so that a big file does not start last; at most one task a thread in flight, so
     // memory holds the footprints kept and one reading per thread.
     std::vector<std::size_t> order(files.size() - fi);
@@ -314,12 +334,19 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
     std::uint64_t shared = 0;  // the bytes these files share the threads with
     for (std::size_t f : order) shared += size[f];
-    std::vector<detail::FileRead> reads(files.size());
-    const detail::ReadContext fixed = context;
+    std::vector<detail::FileRead>(files.size()).swap(reads);
+    detail::ReadContext fixed = context;
+    if (!guess.empty()) fixed.working_definition = guess;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t k = r.begin(); k != r.end(); ++k)
-        reads[order[k]] = detail::read_file(files[order[k]], options, fixed, threads, shared, bytes);
+      for (std::size_t k = r.begin(); k != r.end(); ++k)  // with a guess, the first file as it is read alone
+        reads[order[k]] = detail::read_file(files[order[k]], options, guess.empty() || order[k] ? fixed : context,
+                                            threads, shared, bytes);
     }, tbb::simple_partitioner());
+    if (guess.empty() || detail::guess_held(reads[0], files[0], context, guess)) break;
+    guess.clear();  // not what the first file fixed (never seen): read again the way without a guess
+  }
+  result.reading.crs_guessed = !guess.empty();
+  if (fi < files.size()) {
     if (result.footprints.empty()) {  // the first file's vector taken whole, as merge_file takes it
       result.footprints = std::move(reads[fi].footprints);
       reads[fi].footprints.clear();

@@ -364,12 +364,22 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
   // Until the working CRS is known the files are read one by one (the first georeferenced one decides it), by
   // rank 0; the others learn the CRS from it and how far it read, and the files left are cut into contiguous
   // runs of about equal bytes, one a rank.
+  // With the working CRS guessed from the first tile's first building (rank 0), the first tile is read side by side
+  // with the others, in the context it is read in alone (`first`), and every rank starts at once; rank 0 checks the
+  // guess once that tile is read.
   std::size_t fi = 0;
-  if (me == 0)
-    for (; fi < files.size() && context.working_definition.empty(); ++fi) {
+  std::string guess;
+  const detail::ReadContext first = context;
+  if (me == 0) {
+    if (context.working_definition.empty() && files.size() > 1)
+      guess = detail::guess_working_definition(files[0], options, context);
+    acc.reading.crs_guessed = !guess.empty();
+    for (; guess.empty() && fi < files.size() && context.working_definition.empty(); ++fi) {
       map_tile(detail::read_file(files[fi], options, context, threads, 0, bytes), fi);
       ts.tiles_in_flight = std::max<std::size_t>(ts.tiles_in_flight, 1);
     }
+    if (!guess.empty()) context.working_definition = guess;
+  }
   std::vector<std::size_t> bounds{0, files.size()};
   if (ranks > 1) {
     detail::Packer p;
@@ -402,8 +412,15 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     const detail::ReadContext fixed = context;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k)
-        reads[k] = detail::read_file(files[fi + k], options, fixed, threads, shared, bytes);
+        reads[k] = detail::read_file(files[fi + k], options, guess.empty() || fi + k ? fixed : first, threads, shared,
+                                     bytes);
     }, tbb::simple_partitioner());
+    if (!guess.empty() && fi == 0) {
+      if (!detail::guess_held(reads[0], files[0], first, guess))  // never seen; the tiles read with it are wrong
+        throw Error("tiled run: " + files[0] + " fixed another working CRS than its first building said (" + guess +
+                    "); run it with --tiles off");
+      context = first;  // merge_file fixes it from the first tile, as without the guess
+    }
     for (std::size_t k = 0; k < n; ++k) map_tile(std::move(reads[k]), fi + k);
     ts.tiles_in_flight = std::max(ts.tiles_in_flight, n);
     fi += n;

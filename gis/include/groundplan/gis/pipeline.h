@@ -63,6 +63,9 @@ struct ReadStats {
   /// CityGML files (some or all of them) streamed through expat instead of parsed in memory by pugixml (the
   /// faster path, citygml.h dom_max_bytes), and why: too large, another encoding, a DOCTYPE, malformed XML ...
   std::vector<std::pair<std::string, std::string>> xml_streamed;
+  /// The working CRS was taken from the first file's first building, and the first file read side by side with
+  /// the others (false: it was read before them, or no file needed it: -t_srs, one file).
+  bool crs_guessed = false;
 };
 
 struct StageTimings {
