@@ -5,7 +5,7 @@
 // process per (engine, size) so that peak memory (getrusage ru_maxrss) belongs to one engine.
 //
 //   bench_union --n 6000 --engine ours|geos|dsu|coverage|clipper2|clipper2_groups|boost [--runs 5] [--seed 1]
-//               [--threads 0] [--coverage] [--input FOOTPRINTS.csv] [--repeat K]
+//               [--threads 0] [--coverage] [--input FOOTPRINTS.csv] [--min-time S]
 //   bench_union --n 6000 --verify [--coverage]     (compare our plans with GEOS UnaryUnion, exit 1 if not)
 //   bench_union --n 60000 --profile [--runs 5]    (where our union's time goes, by block size)
 //   bench_union ... --engine ours --dump FILE      (our plans and problems, every coordinate as a hex float, to
@@ -255,7 +255,8 @@ int profile(const std::vector<groundplan::Footprint>& fps, int runs) {
 int main(int argc, char** argv) {
   std::size_t n = 6000;
   std::string engine = "ours";
-  int runs = 5, threads = 0, repeat = 1;  // repeat: calls a timed run (small inputs), times per call
+  int runs = 5, threads = 0;
+  double min_time = 0;  // small inputs: a timed run repeats the call until this much CPU time, timed per call
   std::uint64_t seed = 1;
   bool coverage = false, verify = false, prof = false;
   std::string input, dump;
@@ -272,7 +273,7 @@ int main(int argc, char** argv) {
     else if (a == "--profile") prof = true;
     else if (a == "--input") input = next();
     else if (a == "--dump") dump = next();
-    else if (a == "--repeat") repeat = std::max(1, std::atoi(next()));
+    else if (a == "--min-time") min_time = std::atof(next());
     else {
       std::fprintf(stderr, "usage: %s --n N --engine ours|geos|dsu|coverage|clipper2|clipper2_groups|boost [--runs R] "
                    "[--seed S] [--threads T] [--coverage] [--input FILE] [--verify] [--profile]\n", argv[0]);
@@ -313,7 +314,8 @@ int main(int argc, char** argv) {
   for (int r = 0; r < runs; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpu_seconds();
-    for (int rep = 0; rep < repeat; ++rep) {
+    int calls = 0;
+    for (int rep = 0; rep == 0 || cpu_seconds() - c0 < min_time; ++rep, ++calls) {
     if (engine == "ours") {
       groundplan::UnionParams p;
       p.threads = threads;
@@ -334,8 +336,8 @@ int main(int argc, char** argv) {
       return 2;
     }
     }
-    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / repeat);
-    cpu.push_back((cpu_seconds() - c0) / repeat);
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / calls);
+    cpu.push_back((cpu_seconds() - c0) / calls);
   }
   std::sort(t.begin(), t.end());
   std::sort(cpu.begin(), cpu.end());

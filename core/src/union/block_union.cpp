@@ -757,7 +757,12 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     mark(group, L, cur, x0);
     rays_at(L, x0, cands, rays);
     std::size_t g0 = 0, g1 = 0;
-    if (!choose_outgoing(L.b, L.a, rays, g0, g1, Parity{})) {
+    // A plain corner: the ray back along this edge (the reference, swept last) and one other, which the sweep
+    // from the exterior enters the union by: choose_outgoing would return it alone, so no sort is needed.
+    if (rays.size() == 2 && rays[0].edge == L.e && ray_class(L.b, L.a, rays[0]) == 3 && ray_class(L.b, L.a, rays[1]) != 3) {
+      g0 = 1;
+      g1 = 2;
+    } else if (!choose_outgoing(L.b, L.a, rays, g0, g1, Parity{})) {
       const Point2 p = point_of(L, x0);
       throw TopologyError("boundary walk found no way out of a vertex (groundplan bug; please report)", p.x, p.y);
     }
