@@ -192,6 +192,7 @@ class BlockEngine {
     polys_.clear();
     ring_first_.clear();
     edge_ring_.clear();
+    poly_grid_built_ = false;
     pieces_.clear();
     first_piece_.clear();
     rings_.clear();
@@ -241,6 +242,8 @@ class BlockEngine {
   std::vector<std::uint32_t> edge_ring_;   // the ring of each edge
   std::vector<std::uint32_t> sr_order_, sr_comp_;  // mark_simple_rings(): scratch
   std::vector<std::uint8_t> sr_bad_;
+  std::vector<Box> sr_rbox_;
+  bool poly_grid_built_ = false;  // in this block
   std::vector<std::uint8_t> ring_simple_;  // per ring: in a component of rings apart (mark_simple_rings)
   std::vector<std::uint8_t> ring_done_;    // per such ring: taken (or covered)
   std::vector<signed char> sr_side_;       // per such ring: +1 union on the left of its edges, -1 right, 0 covered
@@ -407,10 +410,30 @@ std::size_t BlockEngine::mark_simple_rings() {
     for (std::uint32_t e = ring_first_[q]; e < ring_first_[q + 1]; ++e) sr_pts_.push_back(edges_[e].p0);
     return point_in_ring(v, sr_pts_);
   };
+  // Polygons near a point through the grid (built here for the walk too) where a block has many: no query is
+  // quadratic in the block's size. Rings of a polygon through their boxes (a point outside one is outside it).
+  if (np > 16) {
+    poly_grid_.build(pboxes_, all_, np + 1);
+    poly_grid_built_ = true;
+  }
+  auto polys_at = [&](const Point2& v, auto&& f) {
+    if (poly_grid_built_) {
+      Box pb;
+      pb.add(v);
+      poly_grid_.query(pb, f);
+    } else {
+      for (std::uint32_t o = 0; o < np; ++o) f(o);
+    }
+  };
+  std::vector<Box>& rbox = sr_rbox_;
   for (std::uint32_t p = 0; p < np; ++p) {
     if (bad[comp[p]]) continue;
     const Poly& P = polys_[p];
     const std::uint32_t r0 = edge_ring_[P.first_edge], r1 = edge_ring_[P.end_edge - 1] + 1;
+    if (r1 - r0 > 1) {
+      rbox.assign(r1 - r0, Box{});
+      for (std::uint32_t e = P.first_edge; e < P.end_edge; ++e) rbox[edge_ring_[e] - r0].add(edges_[e].p0);
+    }
     for (std::uint32_t r = r0; r < r1; ++r) {
       std::uint32_t m = ring_first_[r];
       for (std::uint32_t e = m + 1; e < ring_first_[r + 1]; ++e) {
@@ -421,7 +444,7 @@ std::size_t BlockEngine::mark_simple_rings() {
       const Point2& v = edges_[ring_first_[r]].p0;
       int depth = 0;
       for (std::uint32_t q = r0; q < r1 && side != 0; ++q) {
-        if (q == r) continue;
+        if (q == r || !rbox[q - r0].contains(v)) continue;
         const int in = inside(v, q);
         if (in == 0) side = 0;  // cannot happen: the rings do not meet
         depth += in > 0;
@@ -429,8 +452,8 @@ std::size_t BlockEngine::mark_simple_rings() {
       if (depth % 2 == 1) side = -side;
       // covered by another polygon of the component: the union on both sides, no boundary
       bool covered = false;
-      for (std::uint32_t o = 0; o < np && side != 0 && !covered; ++o) {
-        if (o == p || comp[o] != comp[p] || !polys_[o].box.contains(v)) continue;
+      polys_at(v, [&](std::uint32_t o) {
+        if (covered || side == 0 || o == p || comp[o] != comp[p] || !polys_[o].box.contains(v)) return;
         const std::uint32_t q0 = edge_ring_[polys_[o].first_edge], q1 = edge_ring_[polys_[o].end_edge - 1] + 1;
         int odd = 0;
         for (std::uint32_t q = q0; q < q1; ++q) {
@@ -439,7 +462,7 @@ std::size_t BlockEngine::mark_simple_rings() {
           odd ^= in > 0;
         }
         covered = odd != 0;
-      }
+      });
       if (side == 0 && !covered) {
         bad[comp[p]] = 1;  // not simple after all: leave the whole component to the walk
         break;
@@ -949,7 +972,7 @@ BlockResult BlockEngine::run() {
   const std::size_t n_simple = shortcut_ ? mark_simple_rings() : 0;
   if (n_simple == 0) ring_simple_.assign(nr, 0);
   ring_done_.assign(nr, 0);
-  if (n_simple < nr) poly_grid_.build(pboxes_, all_, polys_.size() + 1);
+  if (n_simple < nr && !poly_grid_built_) poly_grid_.build(pboxes_, all_, polys_.size() + 1);
   // §6.1: the rightmost vertex (then topmost) is on the boundary; the wedge above its +x ray is
   // exterior, so the sweep from +x finds the outgoing boundary edge (largest outward-normal x).
   std::uint32_t best = 0;

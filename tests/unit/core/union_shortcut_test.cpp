@@ -102,7 +102,7 @@ TEST(UnionShortcut, SameAsTheWalkOnDetachedBuildingsWithHolesAndIslands) {
   for (int c = 0; c < 400; ++c) {
     std::vector<Footprint> fps;
     const double ox = c % 2 ? 512345.25 : 0, oy = c % 2 ? 5401234.5 : 0;  // city coordinates too
-    const int n = 1 + c % 5;
+    const int n = c % 50 == 0 ? 30 : 1 + c % 5;  // some blocks of many polygons (the grid of polygons)
     std::vector<Footprint> extra;
     for (int i = 0; i < n; ++i) {
       Footprint f;
