@@ -268,6 +268,7 @@ class BlockEngine {
   std::vector<std::uint32_t> walk_seg_edges_, poly_hits_;
   std::vector<Cand> chk_cands_, chk_wcands_;
   std::vector<Event> chk_evs_;
+  std::vector<std::pair<std::size_t, std::uint32_t>> chk_at_;
   std::vector<Ray> chk_rays_, chk_wrays_;
   BlockStats stats_;
   std::size_t step_limit_ = 0;
@@ -934,14 +935,36 @@ void BlockEngine::check_edge(std::uint32_t e) {
     }
     if (!found) return;  // unreachable: e leaves its own start vertex
   }
+  // The rays leaving to either side at each event strictly inside: those of the candidates whose event it is (a
+  // crossing edge leaves to both sides, an edge touching L to the side of its other end; collinear ones to none),
+  // each candidate put at its event once (binary search in the ordered events) instead of every candidate compared
+  // with every event.
+  std::vector<std::pair<std::size_t, std::uint32_t>>& at = chk_at_;  // (event index, candidate index)
+  at.clear();
+  if (evs.size() > 2) {
+    const auto before = [&](const Event& x, const Event& y) { return cmp(L, x, y) < 0; };
+    for (std::uint32_t k = 0; k < cands.size(); ++k) {
+      const Cand& c = cands[k];
+      if (c.kind != Cand::Crossing && c.kind != Cand::Touch0 && c.kind != Cand::Touch1) continue;
+      const Event ev = event_of(L, c, 0);
+      const auto it = std::lower_bound(evs.begin() + 1, evs.end() - 1, ev, before);
+      if (it != evs.end() - 1 && cmp(L, *it, ev) == 0) at.emplace_back(static_cast<std::size_t>(it - evs.begin()), k);
+    }
+    std::sort(at.begin(), at.end());
+  }
+  std::size_t next_at = 0;
   for (std::size_t i = 0; i + 1 < evs.size(); ++i) {
-    if (i > 0) {
-      rays_at(L, evs[i], cands, rays);
-      for (const Ray& r : rays) {
-        const int c = cross_sign(L.a, L.b, r.from, r.to);
-        if (c > 0) left.toggle(r.poly);
-        if (c < 0) right.toggle(r.poly);
+    for (; next_at < at.size() && at[next_at].first == i; ++next_at) {
+      const Cand& c = cands[at[next_at].second];
+      const Edge& f = edges_[c.edge];
+      if (c.kind == Cand::Crossing) {
+        left.toggle(f.poly);
+        right.toggle(f.poly);
+        continue;
       }
+      const int side = c.kind == Cand::Touch0 ? cross_sign(L.a, L.b, f.p0, f.p1) : cross_sign(L.a, L.b, f.p1, f.p0);
+      if (side > 0) left.toggle(f.poly);
+      if (side < 0) right.toggle(f.poly);
     }
     if (left.inside() == right.inside()) continue;
     if (walked(e, L, evs[i], evs[i + 1])) continue;
