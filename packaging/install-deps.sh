@@ -27,6 +27,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev python3-pytest
   # the GeoPandas/Shapely baseline of the OGR-input benchmark (issue 22, tests/bench/ogr_input_bench.sh)
   python3-geopandas
+  # Boost.Polygon headers: an anchor of the union benchmark only (bench_union --engine boost, tests/bench/union_anchors.sh)
+  libboost-dev
   # the Python module (issue 23, python/): pybind11 and the headers to build it; Shapely, GeoPandas (Fiona,
   # pyproj) for its wrapper and tests. Debian bookworm has no pyogrio: its test skips.
   python3-dev pybind11-dev python3-shapely python3-fiona python3-pyproj python3-numpy

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The one place that chooses a raster backend (STYLE.md §6). Cuda: the CUDA backend from its module
 // (blocks/cuda_raster_backend.h), or GpuError saying why when the module cannot be loaded or no device
-// answers. Auto: CUDA when the module loads, a device answers and the work is large enough to pay for
-// starting it (kCudaAutoMinFootprints), else CPU. Both give the same blocks and seeds.
+// answers. Auto: the CPU: measured on a 16-core GPU host, the CPU finds the blocks of a 1.5 GB city in
+// 0.06 s where the CUDA backend takes 0.33 s with its start (tests/bench/RESULTS.md), so no size was found
+// where the GPU pays (and the module is never loaded for it). Both give the same blocks and seeds.
 #include <groundplan/error.h>
 #include <groundplan/raster_backend.h>
 
@@ -11,20 +12,11 @@
 
 namespace groundplan {
 
-std::unique_ptr<RasterBackend> make_raster_backend(Device requested, std::size_t footprints) {
+std::unique_ptr<RasterBackend> make_raster_backend(Device requested) {
   switch (requested) {
     case Device::Cuda:
       return detail::make_cuda_raster_backend();  // throws GpuError when the module or a device is missing
     case Device::Auto:
-      // below the threshold the module is not even loaded
-      if (footprints >= kCudaAutoMinFootprints && detail::cuda_device_count() > 0) {
-        try {
-          return detail::make_cuda_raster_backend();
-        } catch (const GpuError&) {
-          // a device that answers the count but cannot start a context: the CPU gives the same blocks
-        }
-      }
-      break;
     case Device::Cpu:
       break;
   }

@@ -83,7 +83,7 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl, Ra
   app.add_option("--resolution", resolution, "Raster pixel in metres for blocks and seeds (0 = automatic); exact "
                                               "result whatever the value")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--device", device, "auto|cpu|cuda: where blocks are rasterised (auto: the GPU from 500k footprints)");
+  app.add_option("--device", device, "auto|cpu|cuda: where blocks are rasterised (auto: the CPU; cuda only when asked for)");
   app.add_option("--footprints", footprints, "auto|ground-surface|decompose: where footprints come from");
   app.add_option("--origin", origin, "lon,lat[,alt] where a glTF without georeference or a bare .dae sits");
   std::string axis_order = "auto";

@@ -16,7 +16,7 @@ const char* open_option_list_xml() {
   return "<OpenOptionList>"
          "  <Option name='RESOLUTION' type='float' description='Raster pixel size in metres used to find blocks and "
          "seeds (0 = automatic). The result is exact whatever the value.' default='0'/>"
-         "  <Option name='DEVICE' type='string-select' description='Where blocks are rasterised (AUTO: the GPU from 500k footprints)' default='AUTO'>"
+         "  <Option name='DEVICE' type='string-select' description='Where blocks are rasterised (AUTO: the CPU; CUDA only when asked for)' default='AUTO'>"
          "    <Value>AUTO</Value><Value>CPU</Value><Value>CUDA</Value>"
          "  </Option>"
          "  <Option name='FOOTPRINTS' type='string-select' description='Where footprints come from: explicit ground "

@@ -245,7 +245,7 @@ def union(
         never depends on it.
     snap, close_gaps, simplify, min_hole_area, min_area: the level of detail of ``groundplan --snap``,
         ``--close-gaps`` ... (0 = off; docs/level_of_detail.md). With all of them 0 the result is the exact union.
-    device: "auto", "cpu" or "cuda" (raster backend; "auto" uses the CPU where no GPU answers).
+    device: "auto", "cpu" or "cuda" (raster backend; "auto" is the CPU; "cuda" only when asked for).
     progress: called as ``progress(fraction, message)`` on the calling thread, with increasing fractions
         in [0, 1]; returning ``False`` cancels (:class:`Cancelled`), an exception it raises is re-raised.
 

@@ -74,16 +74,13 @@ void expect_same(RasterBackend& gpu, const std::vector<Footprint>& fps, double r
   }
 }
 
-// Auto takes the GPU only when the work pays for starting CUDA (kCudaAutoMinFootprints); an
-// explicit Cuda always does. The pipeline's default is Auto, so a small city on a GPU host must not
-// wait ~0.3 s for a context it does not need.
-TEST(CudaRasterBackend, AutoTakesTheGpuOnlyForLargeInputs) {
+// Auto never takes the GPU (on the 16-core host the CPU found a 1.5 GB city's blocks in 0.06 s, CUDA in
+// 0.33 s with its start); an explicit Cuda always does. The pipeline's default is Auto.
+TEST(CudaRasterBackend, AutoIsTheCpuEvenWithADevice) {
   REQUIRE_CUDA(gpu);
   EXPECT_STREQ(gpu->name(), "cuda");
-  EXPECT_STREQ(make_raster_backend(Device::Auto, 1000)->name(), "cpu");
-  EXPECT_STREQ(make_raster_backend(Device::Auto, kCudaAutoMinFootprints - 1)->name(), "cpu");
-  EXPECT_STREQ(make_raster_backend(Device::Auto, kCudaAutoMinFootprints)->name(), "cuda");
-  EXPECT_STREQ(make_raster_backend(Device::Cuda, 1000)->name(), "cuda");
+  EXPECT_STREQ(make_raster_backend(Device::Auto)->name(), "cpu");
+  EXPECT_STREQ(make_raster_backend(Device::Cuda)->name(), "cuda");
 }
 
 TEST(CudaRasterBackend, SameAsCpuOnSyntheticCities) {

@@ -75,14 +75,10 @@ FootprintSet make_footprint_set(const std::vector<Footprint>& footprints);
 /// average: the raster only finds blocks, so a coarser one costs no exactness.
 PixelGrid make_pixel_grid(const FootprintSet& fps, double resolution_m);
 
-/// Device::Auto takes the GPU only for at least this many footprints. Starting CUDA costs 0.22-0.35 s
-/// (an H100 host, tests/bench/RESULTS.md), while the CPU finds blocks at ~0.8-1.2 us a footprint and
-/// the GPU at ~0.04: the GPU pays for its start from about 300k-400k footprints on 1-2 cores.
-inline constexpr std::size_t kCudaAutoMinFootprints = 500000;
-
-/// Cpu: the CPU backend. Cuda: the CUDA backend, or GpuError when it is not built in or no device
-/// answers. Auto: CUDA when it is built in, a device answers and `footprints` (the size of the work)
-/// is at least kCudaAutoMinFootprints, else the CPU. Every backend gives the same blocks and seeds.
-std::unique_ptr<RasterBackend> make_raster_backend(Device requested, std::size_t footprints = SIZE_MAX);
+/// Cpu and Auto: the CPU backend. Cuda: the CUDA backend, or GpuError when it is not built in or no device
+/// answers. Auto never takes the GPU: on every host measured the CPU found the blocks faster, CUDA's start
+/// counted (0.06 s against 0.33 s for a 1.5 GB city on 16 cores, tests/bench/RESULTS.md). Every backend
+/// gives the same blocks and seeds.
+std::unique_ptr<RasterBackend> make_raster_backend(Device requested);
 
 }  // namespace groundplan

@@ -45,6 +45,7 @@
 #include "union/block_union.h"
 #include "union/block_types.h"
 #include "union/box_grid.h"
+#include "union/output_rounding.h"
 #include "union/ring_builder.h"
 
 #include <groundplan/error.h>
@@ -153,16 +154,45 @@ struct Piece {
 };
 constexpr std::uint32_t kNone = 0xffffffffu;
 
+/// How edge f meets the segment of L: one of the candidate kinds, or false where they do not meet.
+bool meets(const Line& L, const Edge& f, Cand::Kind& kind) {
+  const int o0 = orient(L.a, L.b, f.p0), o1 = orient(L.a, L.b, f.p1);
+  if (o0 == 0 && o1 == 0) {
+    // collinear: overlap of the extents along the line
+    const Point2& lo = L.cmp_vv(f.p0, f.p1) <= 0 ? f.p0 : f.p1;
+    const Point2& hi = L.cmp_vv(f.p0, f.p1) <= 0 ? f.p1 : f.p0;
+    kind = Cand::Collinear;
+    return L.cmp_vv(hi, L.a) >= 0 && L.cmp_vv(lo, L.b) <= 0;
+  }
+  if (o0 == 0) {
+    kind = Cand::Touch0;
+    return L.within(f.p0);
+  }
+  if (o1 == 0) {
+    kind = Cand::Touch1;
+    return L.within(f.p1);
+  }
+  if (o0 == o1) return false;
+  const int pa = orient(f.p0, f.p1, L.a), pb = orient(f.p0, f.p1, L.b);
+  kind = pa == 0 ? Cand::PassA : pb == 0 ? Cand::PassB : Cand::Crossing;
+  return pa == 0 || pb == 0 || pa != pb;
+}
+
 class BlockEngine {
  public:
   BlockEngine() = default;
   /// Prepares for one block, keeping the capacity of every buffer (one engine per thread).
-  void reset(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members, double pitch) {
+  void reset(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members, double pitch,
+             bool shortcut) {
     pitch_ = pitch;
+    shortcut_ = shortcut;
     footprints_ = &footprints;
     members_ = &members;
     edges_.clear();
     polys_.clear();
+    ring_first_.clear();
+    edge_ring_.clear();
+    poly_grid_built_ = false;
     pieces_.clear();
     first_piece_.clear();
     rings_.clear();
@@ -175,6 +205,10 @@ class BlockEngine {
  private:
   // --- setup
   void load();
+  // --- the shortcut: a block whose rings neither touch nor cross one another or themselves
+  std::size_t mark_simple_rings();
+  void take_ring(std::uint32_t e, bool from_seed);
+  void walk_ring(std::uint32_t e, bool forward);
   // --- exact event order on a line
   int cmp(const Line& L, const Event& x, const Event& y) const;
   void scan(const Line& L, std::vector<Cand>& out);
@@ -204,6 +238,17 @@ class BlockEngine {
   std::vector<Box> eboxes_, pboxes_;
   std::vector<Edge> edges_;
   std::vector<Poly> polys_;
+  std::vector<std::uint32_t> ring_first_;  // first edge of each ring, then edges_.size()
+  std::vector<std::uint32_t> edge_ring_;   // the ring of each edge
+  std::vector<std::uint32_t> sr_order_, sr_comp_;  // mark_simple_rings(): scratch
+  std::vector<std::uint8_t> sr_bad_;
+  std::vector<Box> sr_rbox_;
+  bool poly_grid_built_ = false;  // in this block
+  std::vector<std::uint8_t> ring_simple_;  // per ring: in a component of rings apart (mark_simple_rings)
+  std::vector<std::uint8_t> ring_done_;    // per such ring: taken (or covered)
+  std::vector<signed char> sr_side_;       // per such ring: +1 union on the left of its edges, -1 right, 0 covered
+  std::vector<Point2> sr_pts_;
+  Box all_;
   BoxGrid poly_grid_;
   // Broad phase, once per block: for each edge, the edges whose closed boxes meet its box (CSR).
   // Every scan runs along one whole input edge, so this list is all it needs.
@@ -223,10 +268,12 @@ class BlockEngine {
   std::vector<std::uint32_t> walk_seg_edges_, poly_hits_;
   std::vector<Cand> chk_cands_, chk_wcands_;
   std::vector<Event> chk_evs_;
+  std::vector<std::pair<std::size_t, std::uint32_t>> chk_at_;
   std::vector<Ray> chk_rays_, chk_wrays_;
   BlockStats stats_;
   std::size_t step_limit_ = 0;
   double pitch_ = 0;
+  bool shortcut_ = true;
 };
 
 // ------------------------------------------------------------------------------------------------
@@ -249,6 +296,8 @@ void BlockEngine::load() {
         }
         while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
         if (ring.size() < 3) return;  // no area under the even-odd rule
+        ring_first_.push_back(static_cast<std::uint32_t>(edges_.size()));
+        edge_ring_.insert(edge_ring_.end(), ring.size(), static_cast<std::uint32_t>(ring_first_.size() - 1));
         for (std::size_t i = 0; i < ring.size(); ++i) {
           const Point2& a = ring[i];
           const Point2& b = ring[(i + 1) % ring.size()];
@@ -277,15 +326,196 @@ void BlockEngine::load() {
       all.maxy = std::max(all.maxy, P.box.maxy);
     }
   }
+  ring_first_.push_back(static_cast<std::uint32_t>(edges_.size()));
+  all_ = all;
   if (edges_.empty()) return;
   build_near_lists(eboxes);
-  poly_grid_.build(pboxes, all, polys_.size() + 1);
   first_piece_.assign(edges_.size(), kNone);
   checked_.assign(edges_.size(), 0);
   pieces_.reserve(edges_.size() + 16);
   // A safety net against a walk that never closes (a bug), not a limit on real input: a ring has
   // at most one step per piece of the block's arrangement, O(E^2) in the worst case.
   step_limit_ = std::min<std::size_t>(edges_.size() * edges_.size() * 4 + 4096, std::size_t{1} << 40);
+}
+
+// ------------------------------------------------------------------------------------------------
+// The shortcut (most blocks are one detached building, and a block the raster made of several buildings is
+// mostly buildings apart). Polygons whose closed boxes meet, transitively, make a component; only edges of one
+// component can meet, and only its polygons can cover its points. Where in a component no edge meets any edge but
+// its two neighbours in its ring, and those only at their common vertex (turning, or going straight on), every ring
+// is simple and no two rings meet. Then a ring is a boundary of the union unless another polygon of the component
+// covers it (the even-odd parity of each polygon is the same all along it), and the walk of a boundary ring is the
+// ring itself, in the direction with the union on the left (its own polygon's parity just inside it, from its
+// orientation and how many of its polygon's rings contain it). run() takes such rings as walks in the order, from
+// the start points and in the directions the walk and the completeness check would (so the plans are the same bit
+// for bit): the ring of the rightmost (then topmost) vertex counter-clockwise from that vertex; then, edges longest
+// first, the ring of the first edge not walked yet, from that edge's start. Other components are walked as before.
+// Returns the number of rings so handled (ring_simple_); their sides in sr_side_ (0: covered, no walk).
+std::size_t BlockEngine::mark_simple_rings() {
+  const auto np = static_cast<std::uint32_t>(polys_.size());
+  const std::size_t nr = ring_first_.size() - 1;
+  // components of polygons by their closed boxes: sweep over x, union-find
+  std::vector<std::uint32_t>& order = sr_order_;
+  std::vector<std::uint32_t>& comp = sr_comp_;
+  order.resize(np);
+  comp.resize(np);
+  std::iota(order.begin(), order.end(), 0u);
+  std::iota(comp.begin(), comp.end(), 0u);
+  auto find = [&](std::uint32_t a) {
+    while (comp[a] != a) a = comp[a] = comp[comp[a]];
+    return a;
+  };
+  if (np > 1) {
+    std::sort(order.begin(), order.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return polys_[a].box.minx < polys_[b].box.minx; });
+    for (std::size_t i = 0; i < np; ++i)
+      for (std::size_t j = i + 1; j < np && polys_[order[j]].box.minx <= polys_[order[i]].box.maxx; ++j)
+        if (polys_[order[i]].box.overlaps(polys_[order[j]].box)) comp[find(order[i])] = find(order[j]);
+  }
+  for (std::uint32_t p = 0; p < np; ++p) comp[p] = find(p);
+  std::vector<std::uint8_t>& bad = sr_bad_;  // per component root: some edges meet
+  bad.assign(np, 0);
+  const auto ne = static_cast<std::uint32_t>(edges_.size());
+  auto next_of = [&](std::uint32_t e) { return e + 1 == ring_first_[edge_ring_[e] + 1] ? ring_first_[edge_ring_[e]] : e + 1; };
+  auto prev_of = [&](std::uint32_t e) { return e == ring_first_[edge_ring_[e]] ? ring_first_[edge_ring_[e] + 1] - 1 : e - 1; };
+  // Every pair of edges whose boxes meet, once (the near lists hold both ways), decided as scan() does.
+  auto meet = [&](std::uint32_t e, std::uint32_t fi) {
+    const Line L(e, edges_[e].p0, edges_[e].p1);
+    const Edge& f = edges_[fi];
+    if (fi == next_of(e) || fi == prev_of(e)) {
+      // they share one vertex; the other end of f off e's line (a turn), or on it going straight on
+      return !(orient(L.a, L.b, fi == next_of(e) ? f.p1 : f.p0) != 0 || same_way(L.a, L.b, f.p0, f.p1));
+    }
+    Cand::Kind kind{};
+    return meets(L, f, kind);
+  };
+  for (std::uint32_t e = 0; e < ne; ++e) {
+    const std::uint32_t c = comp[edges_[e].poly];
+    if (bad[c]) continue;
+    for (std::uint32_t k = near_start_[e]; k < near_start_[e + 1]; ++k) {
+      const std::uint32_t fi = near_items_[k];
+      if (fi > e && meet(e, fi)) {
+        bad[c] = 1;
+        break;
+      }
+    }
+  }
+  ring_simple_.assign(nr, 0);
+  sr_side_.assign(nr, 0);
+  std::size_t n = 0;
+  // Which side of each ring the union is on: its orientation (at its lexicographically smallest vertex, a strict
+  // convex corner of a simple ring), flipped where an odd number of its polygon's other rings contain it; none
+  // where another polygon covers it.
+  auto inside = [&](const Point2& v, std::uint32_t q) {  // v (on no ring of q) lies inside ring q
+    sr_pts_.clear();
+    for (std::uint32_t e = ring_first_[q]; e < ring_first_[q + 1]; ++e) sr_pts_.push_back(edges_[e].p0);
+    return point_in_ring(v, sr_pts_);
+  };
+  // Polygons near a point through the grid (built here for the walk too) where a block has many: no query is
+  // quadratic in the block's size. Rings of a polygon through their boxes (a point outside one is outside it).
+  if (np > 16) {
+    poly_grid_.build(pboxes_, all_, np + 1);
+    poly_grid_built_ = true;
+  }
+  auto polys_at = [&](const Point2& v, auto&& f) {
+    if (poly_grid_built_) {
+      Box pb;
+      pb.add(v);
+      poly_grid_.query(pb, f);
+    } else {
+      for (std::uint32_t o = 0; o < np; ++o) f(o);
+    }
+  };
+  std::vector<Box>& rbox = sr_rbox_;
+  for (std::uint32_t p = 0; p < np; ++p) {
+    if (bad[comp[p]]) continue;
+    const Poly& P = polys_[p];
+    const std::uint32_t r0 = edge_ring_[P.first_edge], r1 = edge_ring_[P.end_edge - 1] + 1;
+    if (r1 - r0 > 1) {
+      rbox.assign(r1 - r0, Box{});
+      for (std::uint32_t e = P.first_edge; e < P.end_edge; ++e) rbox[edge_ring_[e] - r0].add(edges_[e].p0);
+    }
+    for (std::uint32_t r = r0; r < r1; ++r) {
+      std::uint32_t m = ring_first_[r];
+      for (std::uint32_t e = m + 1; e < ring_first_[r + 1]; ++e) {
+        const Point2& q = edges_[e].p0;
+        if (q.x < edges_[m].p0.x || (q.x == edges_[m].p0.x && q.y < edges_[m].p0.y)) m = e;
+      }
+      int side = orient(edges_[prev_of(m)].p0, edges_[m].p0, edges_[m].p1);
+      const Point2& v = edges_[ring_first_[r]].p0;
+      int depth = 0;
+      for (std::uint32_t q = r0; q < r1 && side != 0; ++q) {
+        if (q == r || !rbox[q - r0].contains(v)) continue;
+        const int in = inside(v, q);
+        if (in == 0) side = 0;  // cannot happen: the rings do not meet
+        depth += in > 0;
+      }
+      if (depth % 2 == 1) side = -side;
+      // covered by another polygon of the component: the union on both sides, no boundary
+      bool covered = false;
+      polys_at(v, [&](std::uint32_t o) {
+        if (covered || side == 0 || o == p || comp[o] != comp[p] || !polys_[o].box.contains(v)) return;
+        const std::uint32_t q0 = edge_ring_[polys_[o].first_edge], q1 = edge_ring_[polys_[o].end_edge - 1] + 1;
+        int odd = 0;
+        for (std::uint32_t q = q0; q < q1; ++q) {
+          const int in = inside(v, q);
+          if (in == 0) side = 0;  // cannot happen
+          odd ^= in > 0;
+        }
+        covered = odd != 0;
+      });
+      if (side == 0 && !covered) {
+        bad[comp[p]] = 1;  // not simple after all: leave the whole component to the walk
+        break;
+      }
+      sr_side_[r] = static_cast<signed char>(covered ? 0 : side);
+    }
+  }
+  for (std::uint32_t p = 0; p < np; ++p) {
+    if (bad[comp[p]]) continue;
+    const Poly& P = polys_[p];
+    for (std::uint32_t r = edge_ring_[P.first_edge]; r <= edge_ring_[P.end_edge - 1]; ++r) {
+      ring_simple_[r] = 1;
+      ++n;
+    }
+  }
+  if (n > 0) stats_.simple_rings = 1;
+  return n;
+}
+
+/// Takes ring r as a walk where simple_rings() found it a boundary, starting at edge e (forward: union on the
+/// left of e) or, for the first ring (from_seed), at the rightmost vertex, edge e's start.
+void BlockEngine::take_ring(std::uint32_t e, bool from_seed) {
+  const std::uint32_t r = edge_ring_[e];
+  ring_done_[r] = 1;
+  if (sr_side_[r] == 0) return;  // covered by another polygon: no boundary
+  ++stats_.edges_checked;
+  if (from_seed && sr_side_[r] < 0) {
+    // the rightmost vertex is a start of edge e and the end of the edge before it: counter-clockwise is backward
+    const std::uint32_t first = ring_first_[r], end = ring_first_[r + 1];
+    walk_ring(e == first ? end - 1 : e - 1, false);
+    return;
+  }
+  walk_ring(e, sr_side_[r] > 0);
+}
+
+/// The walk of one ring found by mark_simple_rings(): forward from edge e's start (points e.p1, the next edge's end,
+/// ..., e.p0), or backward from its end (e.p0, the previous edge's start, ..., e.p1), as walk() records them.
+void BlockEngine::walk_ring(std::uint32_t e, bool forward) {
+  const std::uint32_t r = edge_ring_[e], first = ring_first_[r], end = ring_first_[r + 1];
+  RingOut ring;
+  ring.pts.reserve(end - first);
+  if (forward) {
+    for (std::uint32_t k = e; k < end; ++k) ring.pts.push_back(edges_[k].p1);
+    for (std::uint32_t k = first; k < e; ++k) ring.pts.push_back(edges_[k].p1);
+  } else {
+    for (std::uint32_t k = e + 1; k-- > first;) ring.pts.push_back(edges_[k].p0);
+    for (std::uint32_t k = end; k-- > e + 1;) ring.pts.push_back(edges_[k].p0);
+  }
+  ring.polys.push_back(edges_[e].poly);
+  stats_.walk_steps += end - first;
+  ++stats_.rings_traced;
+  rings_.push_back(std::move(ring));
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -347,27 +577,8 @@ void BlockEngine::scan(const Line& L, std::vector<Cand>& out) {
   out.clear();
   for (std::uint32_t k = near_start_[L.e]; k < near_start_[L.e + 1]; ++k) {
     const std::uint32_t fi = near_items_[k];
-    const Edge& f = edges_[fi];
-    const int o0 = orient(L.a, L.b, f.p0), o1 = orient(L.a, L.b, f.p1);
-    if (o0 == 0 && o1 == 0) {
-      // collinear: overlap of the extents along the line
-      const Point2& lo = L.cmp_vv(f.p0, f.p1) <= 0 ? f.p0 : f.p1;
-      const Point2& hi = L.cmp_vv(f.p0, f.p1) <= 0 ? f.p1 : f.p0;
-      if (L.cmp_vv(hi, L.a) >= 0 && L.cmp_vv(lo, L.b) <= 0) out.push_back({fi, Cand::Collinear});
-    } else if (o0 == 0) {
-      if (L.within(f.p0)) out.push_back({fi, Cand::Touch0});
-    } else if (o1 == 0) {
-      if (L.within(f.p1)) out.push_back({fi, Cand::Touch1});
-    } else if (o0 != o1) {
-      const int pa = orient(f.p0, f.p1, L.a), pb = orient(f.p0, f.p1, L.b);
-      if (pa == 0) {
-        out.push_back({fi, Cand::PassA});
-      } else if (pb == 0) {
-        out.push_back({fi, Cand::PassB});
-      } else if (pa != pb) {
-        out.push_back({fi, Cand::Crossing});
-      }
-    }
+    Cand::Kind kind{};
+    if (meets(L, edges_[fi], kind)) out.push_back({fi, kind});
   }
 }
 
@@ -570,7 +781,12 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     mark(group, L, cur, x0);
     rays_at(L, x0, cands, rays);
     std::size_t g0 = 0, g1 = 0;
-    if (!choose_outgoing(L.b, L.a, rays, g0, g1, Parity{})) {
+    // A plain corner: the ray back along this edge (the reference, swept last) and one other, which the sweep
+    // from the exterior enters the union by: choose_outgoing would return it alone, so no sort is needed.
+    if (rays.size() == 2 && rays[0].edge == L.e && ray_class(L.b, L.a, rays[0]) == 3 && ray_class(L.b, L.a, rays[1]) != 3) {
+      g0 = 1;
+      g1 = 2;
+    } else if (!choose_outgoing(L.b, L.a, rays, g0, g1, Parity{})) {
       const Point2 p = point_of(L, x0);
       throw TopologyError("boundary walk found no way out of a vertex (groundplan bug; please report)", p.x, p.y);
     }
@@ -719,14 +935,36 @@ void BlockEngine::check_edge(std::uint32_t e) {
     }
     if (!found) return;  // unreachable: e leaves its own start vertex
   }
+  // The rays leaving to either side at each event strictly inside: those of the candidates whose event it is (a
+  // crossing edge leaves to both sides, an edge touching L to the side of its other end; collinear ones to none),
+  // each candidate put at its event once (binary search in the ordered events) instead of every candidate compared
+  // with every event.
+  std::vector<std::pair<std::size_t, std::uint32_t>>& at = chk_at_;  // (event index, candidate index)
+  at.clear();
+  if (evs.size() > 2) {
+    const auto before = [&](const Event& x, const Event& y) { return cmp(L, x, y) < 0; };
+    for (std::uint32_t k = 0; k < cands.size(); ++k) {
+      const Cand& c = cands[k];
+      if (c.kind != Cand::Crossing && c.kind != Cand::Touch0 && c.kind != Cand::Touch1) continue;
+      const Event ev = event_of(L, c, 0);
+      const auto it = std::lower_bound(evs.begin() + 1, evs.end() - 1, ev, before);
+      if (it != evs.end() - 1 && cmp(L, *it, ev) == 0) at.emplace_back(static_cast<std::size_t>(it - evs.begin()), k);
+    }
+    std::sort(at.begin(), at.end());
+  }
+  std::size_t next_at = 0;
   for (std::size_t i = 0; i + 1 < evs.size(); ++i) {
-    if (i > 0) {
-      rays_at(L, evs[i], cands, rays);
-      for (const Ray& r : rays) {
-        const int c = cross_sign(L.a, L.b, r.from, r.to);
-        if (c > 0) left.toggle(r.poly);
-        if (c < 0) right.toggle(r.poly);
+    for (; next_at < at.size() && at[next_at].first == i; ++next_at) {
+      const Cand& c = cands[at[next_at].second];
+      const Edge& f = edges_[c.edge];
+      if (c.kind == Cand::Crossing) {
+        left.toggle(f.poly);
+        right.toggle(f.poly);
+        continue;
       }
+      const int side = c.kind == Cand::Touch0 ? cross_sign(L.a, L.b, f.p0, f.p1) : cross_sign(L.a, L.b, f.p1, f.p0);
+      if (side > 0) left.toggle(f.poly);
+      if (side < 0) right.toggle(f.poly);
     }
     if (left.inside() == right.inside()) continue;
     if (walked(e, L, evs[i], evs[i + 1])) continue;
@@ -752,6 +990,12 @@ BlockResult BlockEngine::run() {
   BlockResult out;
   load();
   if (edges_.empty()) return out;
+  // Rings apart from every other ring are taken as they are (mark_simple_rings); the others are walked.
+  const std::size_t nr = ring_first_.size() - 1;
+  const std::size_t n_simple = shortcut_ ? mark_simple_rings() : 0;
+  if (n_simple == 0) ring_simple_.assign(nr, 0);
+  ring_done_.assign(nr, 0);
+  if (n_simple < nr && !poly_grid_built_) poly_grid_.build(pboxes_, all_, polys_.size() + 1);
   // §6.1: the rightmost vertex (then topmost) is on the boundary; the wedge above its +x ray is
   // exterior, so the sweep from +x finds the outgoing boundary edge (largest outward-normal x).
   std::uint32_t best = 0;
@@ -760,7 +1004,9 @@ BlockResult BlockEngine::run() {
     const Point2& q = edges_[best].p0;
     if (p.x > q.x || (p.x == q.x && p.y > q.y)) best = i;
   }
-  {
+  if (ring_simple_[edge_ring_[best]]) {
+    take_ring(best, true);
+  } else {
     const Point2 r = edges_[best].p0;
     const Line L(best, r, edges_[best].p1);
     std::vector<Cand> cands;
@@ -782,7 +1028,7 @@ BlockResult BlockEngine::run() {
   std::vector<std::uint32_t>& order = check_order_;
   order.clear();
   for (std::uint32_t e = 0; e < edges_.size(); ++e)
-    if (!fully_walked(e)) order.push_back(e);
+    if (ring_simple_[edge_ring_[e]] ? !ring_done_[edge_ring_[e]] : !fully_walked(e)) order.push_back(e);
   auto len2 = [&](std::uint32_t e) {
     const double dx = edges_[e].p1.x - edges_[e].p0.x, dy = edges_[e].p1.y - edges_[e].p0.y;
     return dx * dx + dy * dy;
@@ -791,7 +1037,13 @@ BlockResult BlockEngine::run() {
     const double la = len2(a), lb = len2(b);
     return la > lb || (la == lb && a < b);
   });
-  for (std::uint32_t e : order) check_edge(e);
+  for (std::uint32_t e : order) {
+    if (!ring_simple_[edge_ring_[e]]) {
+      check_edge(e);
+    } else if (!ring_done_[edge_ring_[e]]) {
+      take_ring(e, false);
+    }
+  }
   assemble(out);
   out.stats = stats_;
   return out;
@@ -800,9 +1052,9 @@ BlockResult BlockEngine::run() {
 }  // namespace
 
 BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members,
-                        double pitch) {
+                        double pitch, bool shortcut) {
   thread_local BlockEngine engine;
-  engine.reset(footprints, members, pitch);
+  engine.reset(footprints, members, pitch, shortcut);
   BlockResult r = engine.run();
   r.pitch = pitch;
   return r;

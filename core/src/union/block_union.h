@@ -16,6 +16,7 @@ struct BlockStats {
   std::uint64_t edges_checked = 0;   // input edges the completeness check had to examine exactly
   std::uint64_t rounding_repairs = 0;// snap rounding: opposite grid edges cancelled (collapsed slivers)
   std::uint64_t snapped_groups = 0;  // groups of walks snap-rounded (they had a crossing point)
+  std::uint64_t simple_rings = 0;    // 1 where the walks were the block's rings themselves (the shortcut)
 };
 
 struct BlockResult {
@@ -33,7 +34,10 @@ struct BlockResult {
 /// TopologyError if a boundary walk does not close (never expected: every decision is exact).
 /// `pitch`: the block's snap-rounding grid (snap_pitch of its largest coordinate magnitude), used where
 /// the block's boundary as rounded is not clean or near-touches (snap_round.h).
+/// `shortcut`: rings that neither touch nor cross one another or themselves, in polygons whose boxes are apart,
+/// are taken as the walks without walking them (the same walks, found in the same order; the usual detached
+/// building). false only for the tests that compare the two.
 BlockResult union_block(const std::vector<Footprint>& footprints, const std::vector<std::uint32_t>& members,
-                        double pitch);
+                        double pitch, bool shortcut = true);
 
 }  // namespace groundplan::detail

@@ -70,7 +70,7 @@ std::vector<GroundPlan> build_ground_plans(const std::vector<Footprint>& footpri
   }
   const PixelGrid grid = make_pixel_grid(fps, params.resolution_m);
   const auto t_blocks = std::chrono::steady_clock::now();  // starting the backend counts: CUDA takes ~0.3 s
-  std::unique_ptr<RasterBackend> backend = make_raster_backend(params.device, fps.indices.size());
+  std::unique_ptr<RasterBackend> backend = make_raster_backend(params.device);
   std::vector<Block> blocks = backend->find_blocks(fps, grid, progress.sub(0.0, 0.1));
   const auto t_union = std::chrono::steady_clock::now();
   if (params.stats) {
