@@ -1,0 +1,379 @@
+// SPDX-License-Identifier: MIT
+// 3D Tiles and compressed glTF: the tilesets of tests/data/3dtiles (made from a CityGML sample by
+// make_tilesets.py with ElementTree, earcut, pyproj, and CesiumGS's 3d-tiles-tools, gltf-pipeline and
+// gltfpack: see SOURCE.txt there) give the plans of that CityGML, one building per feature; levels of
+// detail; the georeference against pyproj's; hostile tilesets and tiles as problems.
+#include <groundplan/error.h>
+#include <groundplan/gis/pipeline.h>
+#include <groundplan/gis/reader.h>
+
+#include <geos_c.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "read_all.h"
+#include "test_config.h"
+#include "test_support.h"
+
+#include <cpl_conv.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace groundplan {
+namespace {
+
+const std::string kCityGml = "citygml1-niedersachsen-lod1-4tiles/LoD1_24065862_2_2021-01-25.gml";
+constexpr std::size_t kBuildings = 80;  // top-level Buildings of kCityGml (make_tilesets.py: 40 west, 40 east)
+
+std::string tiles(const std::string& rel) { return std::string(GROUNDPLAN_TEST_DATA_DIR) + "/data/3dtiles/" + rel; }
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+constexpr double kSnap = 1e-3;
+
+gis::PipelineResult run(const std::string& input, const std::string& id_field = "") {
+  gis::PipelineOptions o;
+  o.inputs = {input};
+  o.t_srs = "EPSG:25832";  // the CityGML's own CRS (ETRS89 / UTM 32N): both read into the same frame
+  o.ogr_input.id_field = id_field;
+  // Buildings that touch in the CityGML share coordinates exactly; stored as float32 they are ~0.1 mm apart
+  // and would not unite. --snap 1 mm (for both inputs alike) makes vertices and edges that close shared.
+  o.detail.snap_m = kSnap;
+  return gis::run_pipeline(o);
+}
+
+/// The plans as one GEOS geometry (a multipolygon of every plan), for distances between two results.
+struct Geos {
+  GEOSContextHandle_t h = GEOS_init_r();
+  ~Geos() { GEOS_finish_r(h); }
+  GEOSGeometry* ring(const Ring& r) const {
+    GEOSCoordSequence* s = GEOSCoordSeq_create_r(h, static_cast<unsigned>(r.size() + 1), 2);
+    for (std::size_t k = 0; k <= r.size(); ++k) {
+      const Point2& p = r[k % r.size()];
+      GEOSCoordSeq_setXY_r(h, s, static_cast<unsigned>(k), p.x, p.y);
+    }
+    return GEOSGeom_createLinearRing_r(h, s);
+  }
+  GEOSGeometry* plans(const std::vector<GroundPlan>& plans) const {
+    std::vector<GEOSGeometry*> polys;
+    for (const GroundPlan& p : plans) {
+      std::vector<GEOSGeometry*> holes;
+      for (const Ring& r : p.polygon.holes) holes.push_back(ring(r));
+      polys.push_back(GEOSGeom_createPolygon_r(h, ring(p.polygon.outer), holes.data(), static_cast<unsigned>(holes.size())));
+    }
+    return GEOSGeom_createCollection_r(h, GEOS_MULTIPOLYGON, polys.data(), static_cast<unsigned>(polys.size()));
+  }
+  /// Hausdorff distance (edges densified into 10 pieces) and the area of the symmetric difference.
+  std::pair<double, double> distance(const std::vector<GroundPlan>& a, const std::vector<GroundPlan>& b) const {
+    GEOSGeometry* ga = plans(a);
+    GEOSGeometry* gb = plans(b);
+    double d = -1, area = -1;
+    GEOSHausdorffDistanceDensify_r(h, ga, gb, 0.1, &d);
+    GEOSGeometry* x = GEOSSymDifference_r(h, ga, gb);
+    GEOSArea_r(h, x, &area);
+    GEOSGeom_destroy_r(h, x);
+    GEOSGeom_destroy_r(h, ga);
+    GEOSGeom_destroy_r(h, gb);
+    return {d, area};
+  }
+};
+
+std::set<std::string> ids(const gis::PipelineResult& r) {
+  std::set<std::string> s;
+  for (const Footprint& f : r.footprints) s.insert(f.source_id);
+  return s;
+}
+
+std::string problems(const gis::PipelineResult& r) {
+  std::string s;
+  for (const Problem& p : r.problems) s += p.code + " " + p.file + " [" + p.source_id + "]: " + p.reason + "\n";
+  return s;
+}
+
+const gis::PipelineResult& citygml() {
+  static const gis::PipelineResult r = run(test::shared_data(kCityGml));
+  return r;
+}
+
+/// The CityGML's top-level Building ids: the footprints that are not BuildingParts (parts have ids of their own).
+std::set<std::string> building_ids() {
+  std::set<std::string> s;
+  const std::string text = slurp(test::shared_data(kCityGml));
+  for (std::size_t at = text.find("<bldg:Building gml:id=\""); at != std::string::npos;
+       at = text.find("<bldg:Building gml:id=\"", at + 1)) {
+    const std::size_t from = at + 23;
+    s.insert(text.substr(from, text.find('"', from) - from));
+  }
+  return s;
+}
+
+// The tolerance of plans read from tiles against the CityGML's: the tiles store float32 positions
+// relative to a centre at most ~1.3 km away (ENU or ECEF offsets), where float32's spacing is 2^-13 m
+// (0.12 mm), so each stored coordinate is within 0.06 mm of the double; turned back through the
+// transforms (doubles) and PROJ, a vertex lands within ~0.1 mm of the CityGML's. 1 mm leaves room and
+// is still far below any real difference (a lost or shifted wall is metres).
+constexpr double kFloat32Tolerance = 1e-3;
+
+void expect_plans_of_citygml(const gis::PipelineResult& r, double tolerance, const std::string& what) {
+  const gis::PipelineResult& g = citygml();
+  ASSERT_FALSE(g.plans.empty());
+  EXPECT_EQ(r.crs_name, g.crs_name) << what;
+  EXPECT_EQ(r.plans.size(), g.plans.size()) << what << "\n" << problems(r);
+  const auto [d, area] = Geos().distance(r.plans, g.plans);
+  EXPECT_LE(d, tolerance) << what << ": Hausdorff distance of the plans to the CityGML's";
+  // Every boundary point within `tolerance`: the symmetric difference is at most a band that wide along
+  // the boundaries (both sides).
+  double perimeter = 0;
+  for (const GroundPlan& p : g.plans)
+    for (std::size_t k = 0; k < p.polygon.outer.size(); ++k) {
+      const Point2& a = p.polygon.outer[k];
+      const Point2& b = p.polygon.outer[(k + 1) % p.polygon.outer.size()];
+      perimeter += std::hypot(b.x - a.x, b.y - a.y);
+    }
+  EXPECT_LE(area, 2 * perimeter * tolerance) << what << ": area of the symmetric difference (m²)";
+}
+
+// --- the tilesets against their CityGML -------------------------------------------------------------
+
+TEST(Tiles3d, B3dmTilesetGivesTheCityGmlsPlansOneBuildingPerBatchId) {
+  const gis::PipelineResult r = run(tiles("b3dm/tileset.json"));
+  expect_plans_of_citygml(r, kFloat32Tolerance, "b3dm");
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  EXPECT_EQ(ids(r), building_ids());  // named by the batch table's gml_id
+}
+
+TEST(Tiles3d, FolderWithTilesetJsonAndExternalTilesetAreTheSameTileset) {
+  const gis::PipelineResult folder = run(tiles("b3dm"));
+  const gis::PipelineResult outer = run(tiles("b3dm/outer.json"));
+  const gis::PipelineResult direct = run(tiles("b3dm/tileset.json"));
+  EXPECT_EQ(test::plan_keys(folder.plans), test::plan_keys(direct.plans));
+  EXPECT_EQ(test::plan_keys(outer.plans), test::plan_keys(direct.plans));
+  EXPECT_EQ(outer.footprints.size(), kBuildings);
+}
+
+TEST(Tiles3d, UpgradedGlbTilesetWithMeshFeaturesAndPropertyTable) {
+  // 3d-tiles-tools upgrade: b3dm -> glb with EXT_mesh_features (_FEATURE_ID_0) and EXT_structural_metadata (gml_id)
+  const gis::PipelineResult r = run(tiles("glb/tileset.json"));
+  expect_plans_of_citygml(r, kFloat32Tolerance, "glb 1.1");
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  EXPECT_EQ(ids(r), building_ids());
+}
+
+TEST(Tiles3d, DracoCompressedGlbTileset) {
+  // gltf-pipeline -d with 24-bit positions: steps of 1.5 km / 2^24 = 0.09 mm, within the float32 tolerance.
+  const gis::PipelineResult r = run(tiles("draco/tileset.json"));
+  expect_plans_of_citygml(r, kFloat32Tolerance, "Draco");
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  EXPECT_EQ(ids(r), building_ids());
+}
+
+TEST(Tiles3d, MeshoptCompressedGlbOneBuildingPerNamedNode) {
+  // gltfpack -c -noq: EXT_meshopt_compression of the float positions as they were (lossless).
+  const gis::PipelineResult r = run(tiles("meshopt/nodes.json"));
+  expect_plans_of_citygml(r, kFloat32Tolerance, "meshopt");
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  EXPECT_EQ(ids(r), building_ids());  // no feature ids: the named nodes
+}
+
+TEST(Tiles3d, QuantizedPositionsLandWithinHalfAStep) {
+  // gltfpack -vp 16 -vpn: KHR_mesh_quantization, positions as 16-bit normalized integers over the city's
+  // box (at most ~2 km across: steps of at most 2000 / 65535 = 3.1 cm), dequantized by the node transforms.
+  // Every vertex lies within half a step on each axis (2.7 cm in 3D) of the b3dm's same building's.
+  gis::ReadOptions opt;
+  opt.target_srs = "EPSG:25832";
+  const test::Read q = test::read(tiles("meshopt/quantized.json"), opt);
+  const test::Read exact = test::read(tiles("b3dm/tileset.json"), opt);
+  ASSERT_EQ(q.meshes.size(), kBuildings) << q.all();
+  std::map<std::string, const Mesh*> by_id;
+  for (const Mesh& m : exact.meshes) by_id[m.source_id] = &m;
+  double worst = 0;
+  for (const Mesh& m : q.meshes) {
+    ASSERT_TRUE(by_id.count(m.source_id)) << m.source_id;
+    for (const Point3& p : m.vertices) {
+      double best = 1e300;
+      for (const Point3& e : by_id[m.source_id]->vertices) best = std::min(best, std::hypot(p.x - e.x, p.y - e.y, p.z - e.z));
+      worst = std::max(worst, best);
+    }
+  }
+  EXPECT_LE(worst, 0.5 * 0.031 * std::sqrt(3.0));
+  EXPECT_GT(worst, 1e-4);  // quantized indeed: not the float positions
+}
+
+TEST(Tiles3d, KhrMeshoptCodecThisMeshoptimizerCannotDecodeIsAClearProblem) {
+  // gltfpack -ce khr writes KHR_meshopt_compression with vertex codec version 1; Debian bookworm's
+  // meshoptimizer 0.18 decodes version 0 only: each view is a problem saying so, never a crash.
+  const test::Read r = test::read(tiles("meshopt/khr.json"));
+  bool said = false;
+  for (const Problem& p : r.problems) said = said || p.reason.find("meshopt codec version 1") != std::string::npos;
+  EXPECT_TRUE(said) << r.all();
+}
+
+TEST(Tiles3d, NoFeatureIdsIsSaidInANote) {
+  const gis::PipelineResult r = run(tiles("meshopt/nodes.json"));
+  bool note = false;
+  for (const Problem& p : r.problems)
+    note = note || (p.code == "NOTE" && p.reason.find("no feature ids") != std::string::npos);
+  EXPECT_TRUE(note) << problems(r);
+}
+
+// --- levels of detail -------------------------------------------------------------------------------
+
+TEST(Tiles3d, ReplaceTakesTheLeavesAndCountsEachBuildingOnce) {
+  // all.b3dm (every building) in the parent, west and east halves in the children, REPLACE.
+  const gis::PipelineResult r = run(tiles("levels/replace.json"));
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  EXPECT_EQ(ids(r), building_ids());
+  expect_plans_of_citygml(r, kFloat32Tolerance, "replace");
+}
+
+TEST(Tiles3d, AddTakesEveryLevel) {
+  // west.b3dm in the parent, east.b3dm in the child, ADD: both.
+  const gis::PipelineResult r = run(tiles("levels/add.json"));
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  expect_plans_of_citygml(r, kFloat32Tolerance, "add");
+}
+
+TEST(Tiles3d, GeometricErrorChoosesTheLevel) {
+  // The parent's geometricError is 500: allowing 600 m stops there (all.b3dm), 100 m goes down to the leaves.
+  CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "600");
+  gis::ReadOptions opt;
+  opt.target_srs = "EPSG:25832";
+  const test::Read coarse = test::read(tiles("levels/replace.json"), opt);
+  CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "100");
+  const test::Read fine = test::read(tiles("levels/replace.json"), opt);
+  CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "many");
+  EXPECT_THROW(test::read(tiles("levels/replace.json"), opt), InvalidArgument);
+  CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", nullptr);
+  EXPECT_EQ(coarse.meshes.size(), kBuildings);
+  EXPECT_EQ(coarse.info.tiles3d.contents, 1u);
+  EXPECT_EQ(coarse.info.tiles3d.skipped_by_level, 0u);
+  EXPECT_EQ(fine.meshes.size(), kBuildings);
+  EXPECT_EQ(fine.info.tiles3d.contents, 2u);
+  EXPECT_EQ(fine.info.tiles3d.skipped_by_level, 1u);
+}
+
+// --- georeference -----------------------------------------------------------------------------------
+
+TEST(Tiles3d, VerticesLandWherePyprojPutsThem) {
+  // georef_check.json: vertices of one building as stored in b3dm/west.b3dm, each with the EPSG:25832
+  // position pyproj computed from those stored numbers (ENU -> ECEF -> EPSG:25832) in make_tilesets.py.
+  const nlohmann::json check = nlohmann::json::parse(slurp(tiles("georef_check.json")));
+  gis::ReadOptions opt;
+  opt.target_srs = "EPSG:25832";
+  const test::Read r = test::read(tiles("b3dm/tileset.json"), opt);
+  const Mesh* m = nullptr;
+  for (const Mesh& mesh : r.meshes)
+    if (mesh.source_id == check["building"].get<std::string>()) m = &mesh;
+  ASSERT_NE(m, nullptr);
+  ASSERT_GE(check["vertices"].size(), 3u);
+  for (const auto& v : check["vertices"]) {
+    const double x = v["epsg25832"][0].get<double>(), y = v["epsg25832"][1].get<double>(), z = v["epsg25832"][2].get<double>();
+    double best = 1e300;
+    for (const Point3& p : m->vertices) best = std::min(best, std::hypot(p.x - x, p.y - y, p.z - z));
+    EXPECT_LE(best, 1e-3) << "vertex " << v.dump();  // mm-precise
+  }
+}
+
+// --- hostile input ----------------------------------------------------------------------------------
+
+std::string tileset_with(const std::string& root) {
+  return R"({"asset":{"version":"1.0"},"geometricError":10,"root":)" + root + "}";
+}
+
+std::string leaf(const std::string& uri, const std::string& extra = "") {
+  return R"({"geometricError":0,"boundingVolume":{"sphere":[0,0,0,1]},"content":{"uri":")" + uri + "\"}" + extra + "}";
+}
+
+TEST(Tiles3dHostile, UrisOutsideTheTilesetOrOnTheNetworkAreNeverRead) {
+  test::TempDir d("gp_3dtiles");
+  const std::string west = slurp(tiles("b3dm/west.b3dm"));
+  d.file("outside.b3dm", west);  // a readable tile, but outside the tileset's folder
+  d.file("set/west.b3dm", west);
+  const std::string enu = nlohmann::json::parse(slurp(tiles("levels/replace.json")))["root"]["transform"].dump();
+  const std::string path = d.file("set/tileset.json", tileset_with(
+      R"({"geometricError":10,"refine":"ADD","transform":)" + enu + R"(,"children":[)" +
+      leaf("http://example.com/a.b3dm") + "," + leaf("../outside.b3dm") + "," + leaf("/etc/passwd") + "," +
+      leaf("sub/..%2F..%2Foutside.b3dm") + "," + leaf("west.b3dm") + "]}"));
+  const test::Read r = test::read(path);
+  EXPECT_EQ(r.count("NETWORK_URI"), 1u) << r.all();
+  EXPECT_EQ(r.count("OUTSIDE_TILESET"), 3u) << r.all();
+  EXPECT_EQ(r.meshes.size(), 40u) << r.all();  // west.b3dm, read once
+}
+
+TEST(Tiles3dHostile, CyclicExternalTilesetsAndAbsurdTransformsAreProblems) {
+  test::TempDir d("gp_3dtiles");
+  d.file("a.json", tileset_with(leaf("b.json")));
+  d.file("b.json", tileset_with(leaf("a.json")));
+  const test::Read cyc = test::read((d.path / "a.json").string());
+  EXPECT_EQ(cyc.count("TILESET_CYCLE"), 1u) << cyc.all();
+
+  d.file("west.b3dm", slurp(tiles("b3dm/west.b3dm")));
+  for (const char* t : {R"([1,0,0,0,0,1,0,0,0,0,1,0,1e300,0,0,1])", R"([1,0,0,0,0,1,0,0,0,0,1,0,0,0,0])",
+                               R"([1e9,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1])", R"([1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,2])"}) {
+    const std::string p = d.file("t.json", tileset_with(leaf("west.b3dm", std::string(",\"transform\":") + t)));
+    const test::Read r = test::read(p);
+    EXPECT_EQ(r.count("BAD_TRANSFORM"), 1u) << t << "\n" << r.all();
+    EXPECT_TRUE(r.meshes.empty());
+  }
+}
+
+TEST(Tiles3dHostile, TruncatedAndLyingB3dmAreProblemsNamingTheTile) {
+  test::TempDir d("gp_3dtiles");
+  const std::string b = slurp(tiles("b3dm/west.b3dm"));
+  auto with_u32 = [&](std::string s, std::size_t at, std::uint32_t v) {
+    std::memcpy(s.data() + at, &v, 4);
+    return s;
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"short.b3dm", b.substr(0, 20)},                                    // header cut
+      {"cut.b3dm", b.substr(0, b.size() / 2)},                            // byteLength says more than there is
+      {"ft.b3dm", with_u32(b, 12, 0x7fffffff)},                           // feature table length lies
+      {"bt.b3dm", with_u32(b, 20, 0x20000000)},                           // batch table length lies
+      {"ver.b3dm", with_u32(b, 4, 7)},                                    // unknown version
+      {"glb.b3dm", with_u32(b, 8, static_cast<std::uint32_t>(b.size() - 100))},  // glb cut inside
+      {"cmpt.cmpt", std::string("cmpt") + std::string("\1\0\0\0", 4) + std::string("\x20\0\0\0", 4) +
+                        std::string("\5\0\0\0", 4) + std::string(16, 'x')},  // inner tiles past its end
+      {"i3dm.i3dm", "i3dm" + std::string(40, '\0')}};
+  std::string children;
+  for (const auto& [name, bytes] : cases) {
+    d.file(name, bytes);
+    children += (children.empty() ? "" : ",") + leaf(name);
+  }
+  const std::string p = d.file("tileset.json", tileset_with(R"({"geometricError":1,"refine":"ADD","children":[)" + children + "]}"));
+  const test::Read r = test::read(p);
+  EXPECT_EQ(r.count("UNREADABLE_TILE"), cases.size()) << r.all();
+  for (const auto& [name, bytes] : cases) {
+    bool named = false;
+    for (const Problem& pr : r.problems) named = named || pr.file.find(name) != std::string::npos;
+    EXPECT_TRUE(named) << name << "\n" << r.all();
+  }
+  // The same tiles given alone: an InputError naming the file, never a crash.
+  for (const auto& [name, bytes] : cases) EXPECT_THROW(test::read((d.path / name).string()), InputError) << name;
+}
+
+TEST(GltfCompressed, UnknownRequiredExtensionIsRefusedByName) {
+  test::TempDir d("gp_gltf");
+  std::string glb = slurp(tiles("meshopt/nodes.glb"));
+  const std::size_t at = glb.find("\"extensionsRequired\":[\"");
+  ASSERT_NE(at, std::string::npos);
+  glb.replace(at + 23, 14, "EXT_unknown_xy");  // "KHR_mesh_quant" -> same length
+  const std::string p = d.file("x.glb", glb);
+  try {
+    test::read(p);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("EXT_unknown_xy"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace groundplan
