@@ -41,8 +41,8 @@ std::string extension(const std::string& name) {
 InputFormat sniff(std::string_view head) {
   if (head.size() >= 4 && std::memcmp(head.data(), "PK\x03\x04", 4) == 0) return InputFormat::Kmz;
   if (head.size() >= 4 && std::memcmp(head.data(), "glTF", 4) == 0) return InputFormat::Glb;
-  if (head.size() >= 4 && (std::memcmp(head.data(), "b3dm", 4) == 0 || std::memcmp(head.data(), "cmpt", 4) == 0))
-    return InputFormat::Tiles3d;
+  for (const char* magic : {"b3dm", "cmpt", "i3dm", "pnts"})  // i3dm, pnts: the 3D Tiles reader says they are not read
+    if (head.size() >= 4 && std::memcmp(head.data(), magic, 4) == 0) return InputFormat::Tiles3d;
   const auto first = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
   if (first == std::string_view::npos) return InputFormat::Unknown;
   if (head[first] == '{') {
@@ -133,7 +133,7 @@ InputFormat detect_format(const std::string& gz_name, std::string_view head) {
   if (ext == ".dae") return InputFormat::Collada;
   if (ext == ".gltf") return InputFormat::Gltf;
   if (ext == ".glb") return InputFormat::Glb;
-  if (ext == ".b3dm" || ext == ".cmpt") return InputFormat::Tiles3d;
+  if (ext == ".b3dm" || ext == ".cmpt" || ext == ".i3dm" || ext == ".pnts") return InputFormat::Tiles3d;
   if (lower(name) == "tileset.json" || ends_with(lower(name), "/tileset.json") || ends_with(lower(name), "\\tileset.json"))
     return InputFormat::Tiles3d;
   if (ext == ".jsonl") return InputFormat::CityJsonSeq;  // the reader says when it is not CityJSONSeq

@@ -17,7 +17,9 @@
 
 #include <cpl_conv.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
@@ -333,31 +335,51 @@ TEST(Tiles3dHostile, TruncatedAndLyingB3dmAreProblemsNamingTheTile) {
     std::memcpy(s.data() + at, &v, 4);
     return s;
   };
-  const std::vector<std::pair<std::string, std::string>> cases = {
-      {"short.b3dm", b.substr(0, 20)},                                    // header cut
-      {"cut.b3dm", b.substr(0, b.size() / 2)},                            // byteLength says more than there is
-      {"ft.b3dm", with_u32(b, 12, 0x7fffffff)},                           // feature table length lies
-      {"bt.b3dm", with_u32(b, 20, 0x20000000)},                           // batch table length lies
-      {"ver.b3dm", with_u32(b, 4, 7)},                                    // unknown version
-      {"glb.b3dm", with_u32(b, 8, static_cast<std::uint32_t>(b.size() - 100))},  // glb cut inside
+  // name, bytes, what the problem must say
+  const std::vector<std::array<std::string, 3>> cases = {
+      {"short.b3dm", b.substr(0, 20), "truncated b3dm"},                       // header cut
+      {"cut.b3dm", b.substr(0, b.size() / 2), "says " + std::to_string(b.size()) + " bytes"},  // byteLength > file
+      {"ft.b3dm", with_u32(b, 12, 0x7fffffff), "reach past its byteLength"},  // feature table length lies
+      {"bt.b3dm", with_u32(b, 20, 0x20000000), "reach past its byteLength"},  // batch table length lies
+      {"ver.b3dm", with_u32(b, 4, 7), "version 7"},                            // unknown version
+      {"glb.b3dm", with_u32(b, 8, static_cast<std::uint32_t>(b.size() - 100)), "glTF"},  // glb cut inside
       {"cmpt.cmpt", std::string("cmpt") + std::string("\1\0\0\0", 4) + std::string("\x20\0\0\0", 4) +
-                        std::string("\5\0\0\0", 4) + std::string(16, 'x')},  // inner tiles past its end
-      {"i3dm.i3dm", "i3dm" + std::string(40, '\0')}};
-  std::string children;
-  for (const auto& [name, bytes] : cases) {
-    d.file(name, bytes);
-    children += (children.empty() ? "" : ",") + leaf(name);
+                        std::string("\5\0\0\0", 4) + std::string(16, 'x'), "cmpt inner tile"},  // inner tiles past its end
+      {"i3dm.i3dm", "i3dm" + std::string(40, '\0'), "not read"}};
+  // The tiles under the east-north-up transform that places west.b3dm, beside a good copy of it.
+  const std::string enu = nlohmann::json::parse(slurp(tiles("levels/replace.json")))["root"]["transform"].dump();
+  d.file("good.b3dm", b);
+  std::string children = leaf("good.b3dm");
+  for (const auto& c : cases) {
+    d.file(c[0], c[1]);
+    children += "," + leaf(c[0]);
   }
-  const std::string p = d.file("tileset.json", tileset_with(R"({"geometricError":1,"refine":"ADD","children":[)" + children + "]}"));
+  const std::string p = d.file("tileset.json", tileset_with(R"({"geometricError":1,"refine":"ADD","transform":)" + enu +
+                                                              R"(,"children":[)" + children + "]}"));
   const test::Read r = test::read(p);
+  EXPECT_EQ(r.meshes.size(), 40u) << r.all();  // the good tile
   EXPECT_EQ(r.count("UNREADABLE_TILE"), cases.size()) << r.all();
-  for (const auto& [name, bytes] : cases) {
+  for (const auto& c : cases) {
     bool named = false;
-    for (const Problem& pr : r.problems) named = named || pr.file.find(name) != std::string::npos;
-    EXPECT_TRUE(named) << name << "\n" << r.all();
+    for (const Problem& pr : r.problems)
+      named = named || (pr.code == "UNREADABLE_TILE" && pr.file.find(c[0]) != std::string::npos &&
+                        pr.reason.find(c[2]) != std::string::npos);
+    EXPECT_TRUE(named) << c[0] << " should say \"" << c[2] << "\"\n" << r.all();
   }
-  // The same tiles given alone: an InputError naming the file, never a crash.
-  for (const auto& [name, bytes] : cases) EXPECT_THROW(test::read((d.path / name).string()), InputError) << name;
+  // The same tiles given alone (placed at an origin: they have no transform): an InputError naming the
+  // file, never a crash; the good tile reads.
+  gis::ReadOptions opt;
+  opt.origin = "7.6,52.9,0";
+  EXPECT_EQ(test::read((d.path / "good.b3dm").string(), opt).meshes.size(), 40u);
+  for (const auto& c : cases) {
+    try {
+      test::read((d.path / c[0]).string(), opt);
+      ADD_FAILURE() << c[0] << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c[0]), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c[2]), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(GltfCompressed, UnknownRequiredExtensionIsRefusedByName) {
