@@ -331,7 +331,17 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
             throw InvalidArgument(std::string("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR=") + e + ": not a number of metres >= 0");
           topt.geometric_error = v;
         }
-        read_3d_tiles(path, topt, place_gltf, problems, info.tiles3d);
+        // Progress over tiles: the tileset file's bytes told in shares, one a content.
+        VSIStatBufL st;
+        const std::uint64_t size = VSIStatL(path.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+        std::uint64_t told = 0;
+        auto progress = [&](std::size_t done, std::size_t total) {
+          const std::uint64_t now = total ? size * done / total : size;
+          if (options.on_bytes && now > told) options.on_bytes(now - told);
+          told = now;
+        };
+        read_3d_tiles(path, topt, place_gltf, problems, info.tiles3d, progress);
+        if (options.on_bytes && size > told) options.on_bytes(size - told);
       } catch (...) {
         finish();
         throw;

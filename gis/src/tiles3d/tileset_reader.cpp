@@ -9,11 +9,14 @@
 #include "collada/collada_internal.h"
 
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 
 namespace groundplan::gis {
 namespace {
@@ -63,16 +66,78 @@ class Walker {
     tileset(path, j, detail::kIdentity, "REPLACE", 0);
   }
 
-  /// One content file given alone: the content of a tile without transform.
+  /// One content file given alone: the content of a tile without transform. Throws when it cannot be read.
   void content_alone(const std::string& path) {
-    xml::ByteBudget budget;
-    budget.max_entry_bytes = budget.max_total_bytes = opt_.gltf.max_bytes;
-    const std::string bytes = xml::read_vsi_file(path, path, budget);
-    tiles3d::read_content(path, fs::path(path).filename().string(), bytes, root_folder_.string(), detail::kIdentity,
-                          opt_, cb_, problems_, info_);
+    Job job{path, fs::path(path).filename().string(), detail::kIdentity};
+    Done done = read_job(job);
+    if (!done.failure.empty()) throw InputError(done.failure);
+    deliver(done);
   }
 
+  /// The contents the walk chose, read side by side (each read, parsed and decoded on its own thread),
+  /// delivered in tile order on this thread: at most two contents a thread in flight.
+  void read_contents(const std::function<void(std::size_t done, std::size_t total)>& progress) {
+    const std::size_t n = jobs_.size();
+    std::size_t next = 0, delivered = 0;
+    const auto tokens = static_cast<std::size_t>(2 * std::max(1, tbb::this_task_arena::max_concurrency()));
+    tbb::parallel_pipeline(
+        tokens,
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& fc) -> std::size_t {
+                                              if (next == n) fc.stop();
+                                              return next < n ? next++ : n;
+                                            }) &
+            tbb::make_filter<std::size_t, std::shared_ptr<Done>>(
+                tbb::filter_mode::parallel, [&](std::size_t k) { return std::make_shared<Done>(read_job(jobs_[k])); }) &
+            tbb::make_filter<std::shared_ptr<Done>, void>(tbb::filter_mode::serial_in_order,
+                                                          [&](const std::shared_ptr<Done>& done) {
+                                                            if (!done->failure.empty())
+                                                              problem(done->file, "UNREADABLE_TILE", done->failure);
+                                                            deliver(*done);
+                                                            if (progress) progress(++delivered, n);
+                                                          }));
+  }
+
+  std::size_t contents() const { return jobs_.size(); }
+
  private:
+  struct Job {
+    std::string file, label;
+    Mat4 transform;
+  };
+  /// A content read: its meshes (placed in ECEF or local, not yet in the working CRS) and problems.
+  struct Done {
+    std::string file;
+    std::vector<std::pair<Mesh, GltfFrame>> meshes;
+    std::vector<Problem> problems;
+    Tiles3dInfo info;  // contents, georeference, by_feature of this content
+    std::string failure;  // the content could not be read: why (an InputError's message)
+  };
+
+  Done read_job(const Job& job) const {
+    Done d;
+    d.file = job.file;
+    try {
+      xml::ByteBudget budget;
+      budget.max_entry_bytes = budget.max_total_bytes = opt_.gltf.max_bytes;
+      const std::string bytes = xml::read_vsi_file(job.file, job.file, budget);
+      tiles3d::read_content(job.file, job.label, bytes, root_folder_.string(), job.transform, opt_,
+                            [&](Mesh&& m, GltfFrame f) { d.meshes.emplace_back(std::move(m), f); }, d.problems, d.info);
+    } catch (const InputError& e) {
+      d.failure = e.what();
+    }
+    return d;
+  }
+
+  void deliver(Done& d) {
+    problems_.insert(problems_.end(), std::make_move_iterator(d.problems.begin()), std::make_move_iterator(d.problems.end()));
+    info_.contents += d.info.contents;
+    if (!d.info.georeference.empty()) info_.georeference = d.info.georeference;
+    info_.by_feature = info_.by_feature || d.info.by_feature;
+    for (auto& [mesh, frame] : d.meshes) cb_(std::move(mesh), frame);
+    d.meshes.clear();
+  }
+
   void problem(const std::string& file, const std::string& code, const std::string& reason) {
     problems_.push_back(Problem{"", file, "read", code, reason});
   }
@@ -232,14 +297,7 @@ class Walker {
         ++info_.skipped_by_level;
         continue;
       }
-      try {
-        xml::ByteBudget budget;
-        budget.max_entry_bytes = budget.max_total_bytes = opt_.gltf.max_bytes;
-        const std::string bytes = xml::read_vsi_file(file, file, budget);
-        tiles3d::read_content(file, uri, bytes, root_folder_.string(), world, opt_, cb_, problems_, info_);
-      } catch (const InputError& e) {
-        problem(file, "UNREADABLE_TILE", e.what());
-      }
+      jobs_.push_back(Job{file, uri, world});
     }
     if (stop) return;
     for (const auto& child : t["children"]) tile(tileset_path, child, world, refine, depth + 1);
@@ -265,6 +323,7 @@ class Walker {
   fs::path root_folder_;
   bool vsi_ = false;
   std::vector<std::string> stack_;  // tilesets being read, root first
+  std::vector<Job> jobs_;           // the contents chosen, in tile order
 };
 
 }  // namespace
@@ -276,12 +335,17 @@ bool looks_like_tileset(std::string_view head) {
 }
 
 void read_3d_tiles(const std::string& path, const Tiles3dOptions& options, const GltfMeshCallback& on_mesh,
-                   std::vector<Problem>& problems, Tiles3dInfo& info) {
+                   std::vector<Problem>& problems, Tiles3dInfo& info,
+                   const std::function<void(std::size_t done, std::size_t total)>& progress) {
   info = Tiles3dInfo{};
   Walker w(path, options, on_mesh, problems, info);
   const std::string ext = lower(fs::path(path).extension().string());
-  if (ext == ".b3dm" || ext == ".cmpt" || ext == ".i3dm" || ext == ".pnts") w.content_alone(path);
-  else w.root(path);
+  if (ext == ".b3dm" || ext == ".cmpt" || ext == ".i3dm" || ext == ".pnts") {
+    w.content_alone(path);
+    return;
+  }
+  w.root(path);
+  w.read_contents(progress);
 }
 
 }  // namespace groundplan::gis

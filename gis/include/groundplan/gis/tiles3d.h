@@ -23,6 +23,7 @@
 #include <groundplan/types.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -46,11 +47,15 @@ struct Tiles3dInfo {
   bool by_feature = false;      // some content split its buildings by feature id
 };
 
-/// Reads a tileset.json, or one content file (.b3dm, .cmpt, .glb, .gltf placed as the content of a tile
-/// with no transform). Meshes go to `on_mesh` as the glTF reader gives them (GltfFrame::Ecef when placed
-/// on the Earth). Throws InputError naming the file when the root cannot be read at all.
+/// Reads a tileset.json, or one content file (.b3dm, .cmpt placed as the content of a tile with no
+/// transform). Meshes go to `on_mesh` as the glTF reader gives them (GltfFrame::Ecef when placed on the
+/// Earth), on the calling thread, tile after tile in the tree's order: the tree is walked first (its
+/// JSON only), then the contents chosen are read, parsed and decoded side by side on the current TBB
+/// arena, at most two a thread in flight. `progress` (may be empty) is told after each content.
+/// Throws InputError naming the file when the root cannot be read at all.
 void read_3d_tiles(const std::string& path, const Tiles3dOptions& options, const GltfMeshCallback& on_mesh,
-                   std::vector<Problem>& problems, Tiles3dInfo& info);
+                   std::vector<Problem>& problems, Tiles3dInfo& info,
+                   const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 
 /// True when `head` (the first bytes of a file) is a 3D Tiles tileset: JSON with "asset" and "root".
 bool looks_like_tileset(std::string_view head);
