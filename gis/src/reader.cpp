@@ -96,7 +96,7 @@ namespace {
 // The names a folder or a zip of tiles is expanded to: one list for the checks and for the messages that
 // name them. Gzip: the text formats, with ".gz" after them.
 constexpr std::string_view kInputSuffixes[] = {".gml", ".citygml", ".xml", ".kml", ".kmz", ".gltf", ".glb",
-                                               ".b3dm", ".cmpt", ".city.json", ".city.jsonl"};
+                                               ".b3dm", ".i3dm", ".cmpt", ".city.json", ".city.jsonl"};
 constexpr std::string_view kGzipSuffixes[] = {".gml", ".citygml", ".xml", ".kml", ".city.json", ".city.jsonl"};
 
 template <std::size_t N>

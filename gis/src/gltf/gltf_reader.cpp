@@ -156,6 +156,8 @@ struct FeatureIdSet {
   double null_id = std::numeric_limits<double>::quiet_NaN();
 };
 
+constexpr int kWholeModel = -2;  // feature_mesh's "table" of GltfTile::building: the whole model is one building
+
 class Reader {
  public:
   Reader(const std::string& path, const GltfOptions& opt, const GltfTile* tile, const GltfMeshCallback& cb,
@@ -348,10 +350,10 @@ class Reader {
     const std::string key = std::to_string(table) + ":" + std::to_string(id);
     auto it = features_.find(key);
     if (it != features_.end()) return it->second;
-    std::string name = table >= 0 ? table_string(table, id) : std::string();
+    std::string name = table == kWholeModel ? tile_->building : table >= 0 ? table_string(table, id) : std::string();
     if (name.empty() && tile_ && tile_->feature_name) name = tile_->feature_name(id);
     if (name.empty()) name = (tile_ ? tile_->feature_prefix : std::string("feature ")) + "#" + std::to_string(id);
-    if (id < 0) name = node_id + " (no feature id)";
+    if (id < 0 && table != kWholeModel) name = node_id + " (no feature id)";
     Mesh& mesh = features_[key];
     mesh.source_id = name;
     mesh.source_file = path_;
@@ -467,7 +469,9 @@ class Reader {
     std::vector<std::uint32_t> at(pa.count, UINT32_MAX);
     std::vector<Mesh*> in(pa.count, nullptr);
     auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-      Mesh& mesh = fid.empty() ? node_mesh : feature_mesh(fid[a], fs.property_table, node_id);
+      Mesh& mesh = tile_ && !tile_->building.empty() ? feature_mesh(0, kWholeModel, node_id)
+                   : fid.empty()                           ? node_mesh
+                                                           : feature_mesh(fid[a], fs.property_table, node_id);
       for (std::uint32_t v : {a, b, c}) {
         if (in[v] != &mesh) {  // first time in this building's mesh (a vertex of two features is copied)
           in[v] = &mesh;
@@ -555,6 +559,14 @@ void read_gltf(const std::string& path, const GltfOptions& options, const GltfMe
 void read_gltf_bytes(const std::string& path, const std::string& bytes_in, const std::string& root_folder,
                      const GltfOptions& options, const GltfTile* tile, const GltfMeshCallback& on_mesh,
                      std::vector<Problem>& problems, GltfInfo& info) {
+  if (tile) return read_gltf_instances(path, bytes_in, root_folder, options, {*tile}, on_mesh, problems, info);
+  read_gltf_instances(path, bytes_in, root_folder, options, {}, on_mesh, problems, info);
+}
+
+void read_gltf_instances(const std::string& path, const std::string& bytes_in, const std::string& root_folder,
+                         const GltfOptions& options, const std::vector<GltfTile>& tiles, const GltfMeshCallback& on_mesh,
+                         std::vector<Problem>& problems, GltfInfo& info) {
+  const bool tiled = !tiles.empty();
   info = GltfInfo{};
   info.file = path;
   xml::ByteBudget budget;  // the external buffers
@@ -570,7 +582,7 @@ void read_gltf_bytes(const std::string& path, const std::string& bytes_in, const
   std::error_code ec;
   guard.root = guard.vsi ? folder : fs::weakly_canonical(folder.empty() ? fs::path(".") : folder, ec);
   if (ec) throw InputError(path + ": cannot resolve the file's folder: " + ec.message());
-  const std::string base_dir = guard.vsi || !tile ? guard.root.string()
+  const std::string base_dir = guard.vsi || !tiled ? guard.root.string()
                                                   : fs::weakly_canonical(fs::path(path).parent_path(), ec).string();
 
   const bool glb = bytes_in.size() >= 4 && std::memcmp(bytes_in.data(), "glTF", 4) == 0;
@@ -612,7 +624,24 @@ void read_gltf_bytes(const std::string& path, const std::string& bytes_in, const
   std::vector<std::string> decode_problems;
   gltf::decode(model, decode_problems);
   for (const std::string& why : decode_problems) problems.push_back(Problem{"", path, "read", "BAD_PRIMITIVE", why});
-  Reader(path, options, tile, on_mesh, problems, info, model).run();
+  if (!tiled) return Reader(path, options, nullptr, on_mesh, problems, info, model).run();
+  // The model parsed and decoded once, placed once per tile (a 3D Tiles content; an i3dm's instances).
+  GltfInfo total = info;
+  for (const GltfTile& tile : tiles) {
+    GltfInfo one = info;
+    Reader(path, options, &tile, on_mesh, problems, one, model).run();
+    total.nodes += one.nodes, total.meshes += one.meshes, total.primitives += one.primitives, total.faces += one.faces;
+    total.by_feature = total.by_feature || one.by_feature;
+    if (!one.georeference.empty()) total.georeference = one.georeference;
+    if (total.faces * 3 > options.max_vertices && &tile != &tiles.back()) {  // the bound over all instances
+      problems.push_back(Problem{"", path, "read", "TOO_LARGE",
+                                 "its instances hold more than " + std::to_string(options.max_vertices) +
+                                     " vertices together: the instances after " + std::to_string(&tile - tiles.data() + 1) +
+                                     " of " + std::to_string(tiles.size()) + " are not read"});
+      break;
+    }
+  }
+  info = total;
 }
 
 }  // namespace groundplan::gis

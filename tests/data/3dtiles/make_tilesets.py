@@ -171,6 +171,23 @@ def b3dm(glb_bytes, names, rtc=None):
     return struct.pack("<4s6I", b"b3dm", 1, 28 + len(body), len(ftj), 0, len(btj), 0) + body
 
 
+def i3dm(glb_bytes, rtc, offsets, names):
+    """Instances of one model at RTC_CENTER + offsets (float32), oriented east-north-up, BATCH_ID i, batch table gml_id."""
+    n = len(offsets)
+    pos = np.array(offsets, dtype=np.float32).tobytes()
+    bid = np.arange(n, dtype=np.uint16).tobytes()
+    ftb = pad(pos, 4) + bid
+    ftb = pad(ftb, 8)
+    ft = {"INSTANCES_LENGTH": n, "RTC_CENTER": [float(v) for v in rtc], "EAST_NORTH_UP": True,
+          "POSITION": {"byteOffset": 0}, "BATCH_ID": {"byteOffset": len(pad(pos, 4)), "componentType": "UNSIGNED_SHORT"}}
+    ftj = json.dumps(ft).encode()
+    ftj += b" " * ((-(32 + len(ftj))) % 8)
+    btj = json.dumps({"gml_id": names}).encode()
+    btj += b" " * ((-(32 + len(ftj) + len(ftb) + len(btj))) % 8)
+    body = ftj + ftb + btj + pad(glb_bytes, 8)
+    return struct.pack("<4s7I", b"i3dm", 1, 32 + len(body), len(ftj), len(ftb), len(btj), 0, 1) + body
+
+
 def tile(uri, error, transform=None, children=None, refine=None):
     t = {"boundingVolume": {"sphere": [0, 0, 0, 1e4]}, "geometricError": error}
     if transform is not None:
@@ -215,7 +232,7 @@ def main():
     east = [b for b in blds if b not in west]
     names = lambda bs: [b[0] for b in bs]
     out = HERE
-    for sub in ("b3dm", "glb", "draco", "meshopt", "levels"):
+    for sub in ("b3dm", "glb", "draco", "meshopt", "levels", "i3dm"):
         shutil.rmtree(os.path.join(out, sub), ignore_errors=True)
 
     # 1.0: root translated to the centre; the west tile turned to ENU there (transforms composed); the east tile
@@ -240,6 +257,19 @@ def main():
     write(os.path.join(lv, "replace.json"),
           tileset(tile("all.b3dm", 500, enu, refine="REPLACE", children=[tile("west.b3dm", 0), tile("east.b3dm", 0)])))
     write(os.path.join(lv, "add.json"), tileset(tile("west.b3dm", 500, enu, refine="ADD", children=[tile("east.b3dm", 0)])))
+
+    # i3dm: one building as a model in east-north-up at its own centre, instanced there and 100 m east.
+    b0 = west[0]
+    b0pts = np.array([p for rings in b0[1] for r in rings for p in r])
+    cb = np.array(TO_ECEF.transform(*b0pts.mean(0)))
+    rb = enu_frame(cb)
+    model = batched_glb(*mesh_of([b0], lambda e: (e - cb) @ rb))
+    east100 = 100.0 * rb[:, 0]
+    write(os.path.join(out, "i3dm", "instances.i3dm"), i3dm(model, cb, [[0, 0, 0], east100], [b0[0], b0[0] + "-east"]))
+    write(os.path.join(out, "i3dm", "tileset.json"), tileset(tile("instances.i3dm", 0)))
+    to25832 = pyproj.Transformer.from_crs("EPSG:4978", pyproj.CRS("EPSG:25832").to_3d(), always_xy=True)
+    a, b = np.array(to25832.transform(*cb)), np.array(to25832.transform(*(cb + east100)))
+    i3dm_check = {"building": b0[0], "copy": b0[0] + "-east", "offset_epsg25832": [float(v) for v in b - a]}
 
     prefix, bin_dir = npm_tools()
     try:
@@ -280,7 +310,8 @@ def main():
         e = c + r @ local
         x, y, z = back.transform(*e)
         checks.append({"stored_gltf_y_up": [float(v) for v in p], "epsg25832": [x, y, z]})
-    write(os.path.join(out, "georef_check.json"), {"building": west[0][0], "tile": "b3dm/west.b3dm", "vertices": checks})
+    write(os.path.join(out, "georef_check.json"), {"building": west[0][0], "tile": "b3dm/west.b3dm", "vertices": checks,
+                                                   "i3dm": i3dm_check})
     print(f"{len(blds)} buildings: {len(west)} west, {len(east)} east", file=sys.stderr)
 
 

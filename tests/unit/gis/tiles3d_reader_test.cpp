@@ -285,6 +285,39 @@ TEST(Tiles3d, VerticesLandWherePyprojPutsThem) {
   }
 }
 
+TEST(Tiles3d, I3dmInstancesEastNorthUpNamedByTheirBatchIds) {
+  // instances.i3dm: one building's model (east-north-up at its centre, y-up) instanced at RTC_CENTER = that
+  // centre and 100 m east of it, EAST_NORTH_UP, BATCH_ID 0 and 1, batch table gml_id. Instance 0 lies where
+  // the b3dm puts the same building (1 mm); instance 1 is instance 0 moved by pyproj's EPSG:25832 image of
+  // the 100 m (georef_check.json; the east-north-up frame turns by 100 m / 6378 km = 16 µrad between the two:
+  // 0.3 mm over the building, so 2 mm).
+  const nlohmann::json check = nlohmann::json::parse(slurp(tiles("georef_check.json")))["i3dm"];
+  gis::ReadOptions opt;
+  opt.target_srs = "EPSG:25832";
+  const test::Read r = test::read(tiles("i3dm/tileset.json"), opt);
+  const test::Read exact = test::read(tiles("b3dm/tileset.json"), opt);
+  ASSERT_EQ(r.meshes.size(), 2u) << r.all();
+  EXPECT_EQ(r.meshes[0].source_id, check["building"].get<std::string>());
+  EXPECT_EQ(r.meshes[1].source_id, check["copy"].get<std::string>());
+  const Mesh* ref = nullptr;
+  for (const Mesh& m : exact.meshes)
+    if (m.source_id == r.meshes[0].source_id) ref = &m;
+  ASSERT_NE(ref, nullptr);
+  auto farthest = [](const Mesh& a, const Mesh& b, double dx, double dy, double dz) {
+    double worst = 0;
+    for (const Point3& p : a.vertices) {
+      double best = 1e300;
+      for (const Point3& q : b.vertices) best = std::min(best, std::hypot(p.x + dx - q.x, p.y + dy - q.y, p.z + dz - q.z));
+      worst = std::max(worst, best);
+    }
+    return worst;
+  };
+  EXPECT_LE(farthest(r.meshes[0], *ref, 0, 0, 0), 1e-3);
+  EXPECT_LE(farthest(*ref, r.meshes[0], 0, 0, 0), 1e-3);
+  const auto& d = check["offset_epsg25832"];
+  EXPECT_LE(farthest(r.meshes[0], r.meshes[1], d[0].get<double>(), d[1].get<double>(), d[2].get<double>()), 2e-3);
+}
+
 // --- hostile input ----------------------------------------------------------------------------------
 
 std::string tileset_with(const std::string& root) {
@@ -345,7 +378,8 @@ TEST(Tiles3dHostile, TruncatedAndLyingB3dmAreProblemsNamingTheTile) {
       {"glb.b3dm", with_u32(b, 8, static_cast<std::uint32_t>(b.size() - 100)), "glTF"},  // glb cut inside
       {"cmpt.cmpt", std::string("cmpt") + std::string("\1\0\0\0", 4) + std::string("\x20\0\0\0", 4) +
                         std::string("\5\0\0\0", 4) + std::string(16, 'x'), "cmpt inner tile"},  // inner tiles past its end
-      {"i3dm.i3dm", "i3dm" + std::string(40, '\0'), "not read"}};
+      {"i3dm.i3dm", "i3dm" + std::string(40, '\0'), "i3dm version 0"},
+      {"pnts.pnts", "pnts" + std::string(40, '\0'), "not read"}};
   // The tiles under the east-north-up transform that places west.b3dm, beside a good copy of it.
   const std::string enu = nlohmann::json::parse(slurp(tiles("levels/replace.json")))["root"]["transform"].dump();
   d.file("good.b3dm", b);

@@ -64,6 +64,7 @@ struct GltfTile {
   Point3 rtc_center;
   std::string feature_prefix;   // a feature without an id property is "<prefix>#<feature id>"
   std::function<std::string(std::int64_t)> feature_name;  // a b3dm batch table's id of a feature; "" = none
+  std::string building;         // non-empty: the whole model is one building of this id (an i3dm instance)
 };
 
 /// Called once per node with a mesh; the mesh's frame says how to place it. May be moved from.
@@ -80,5 +81,11 @@ void read_gltf(const std::string& path, const GltfOptions& options, const GltfMe
 void read_gltf_bytes(const std::string& path, const std::string& bytes, const std::string& root_folder,
                      const GltfOptions& options, const GltfTile* tile, const GltfMeshCallback& on_mesh,
                      std::vector<Problem>& problems, GltfInfo& info);
+
+/// The same model placed once per entry of `tiles` (parsed and decoded once): an i3dm's instances.
+/// Without tiles, as read_gltf_bytes without a tile.
+void read_gltf_instances(const std::string& path, const std::string& bytes, const std::string& root_folder,
+                         const GltfOptions& options, const std::vector<GltfTile>& tiles, const GltfMeshCallback& on_mesh,
+                         std::vector<Problem>& problems, GltfInfo& info);
 
 }  // namespace groundplan::gis

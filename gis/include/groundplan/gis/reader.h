@@ -82,7 +82,7 @@ InputFormat detect_format(const std::string& path);
 /// The same from a file name and its first bytes (for a driver's Identify). Does not throw.
 InputFormat detect_format(const std::string& name, std::string_view head);
 /// True for the extensions a folder of tiles is expanded to (.gml .citygml .xml .kml .kmz .gltf .glb
-/// .b3dm .cmpt .city.json .city.jsonl; a folder holding a tileset.json is that tileset instead; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
+/// .b3dm .i3dm .cmpt .city.json .city.jsonl; a folder holding a tileset.json is that tileset instead; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
 /// plain .json: a tile folder holds other JSON, e.g. 3D Tiles' tileset.json).
 bool is_input_name(const std::string& name);
 /// The names is_input_name takes, for messages: "*.gml, *.citygml, ..., *.city.jsonl.gz".

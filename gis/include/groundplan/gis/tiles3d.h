@@ -3,8 +3,10 @@
 // OGC 3D Tiles (1.0 and 1.1) as input: a tileset.json, or one tile's content file (.b3dm, .cmpt,
 // .glb/.gltf). The tile tree is walked from the root, each tile's `transform` composed down to its
 // content; contents are b3dm (feature table RTC_CENTER and BATCH_LENGTH, JSON batch table, the glTF's
-// _BATCHID), cmpt (its inner tiles), glb/glTF (CESIUM_RTC, EXT_mesh_features, EXT_structural_metadata),
-// external tilesets (a content .json) and 1.1's multiple contents. Each content's glTF is read by the glTF
+// _BATCHID), i3dm (an embedded glb placed once per instance: POSITION or POSITION_QUANTIZED, RTC_CENTER,
+// NORMAL_UP/RIGHT or their OCT32P forms or EAST_NORTH_UP, SCALE, SCALE_NON_UNIFORM; one building an
+// instance, named by BATCH_ID in the batch table), cmpt (its inner tiles), glb/glTF (CESIUM_RTC,
+// EXT_mesh_features, EXT_structural_metadata), external tilesets (a content .json) and 1.1's multiple contents. Each content's glTF is read by the glTF
 // reader (gltf.h): y-up to z-up, then RTC centre, then the tile transform: ECEF (EPSG:4978).
 //
 // Levels of detail: by default the finest level: a tile's content is taken when the tile has no
@@ -16,8 +18,8 @@
 // leaves the root tileset's folder (.., an absolute path, a symbolic link out) is never read, external
 // tilesets that include themselves are cut, transforms that are not finite or not a placement on the
 // Earth are refused, and every header length of b3dm/cmpt is checked against the bytes there are: each
-// is a Problem naming the tile, and the other tiles are read. Not read (a Problem says so): i3dm
-// (instanced models), pnts (points), implicit tiling.
+// is a Problem naming the tile, and the other tiles are read. Not read (a Problem says so): pnts
+// (points), an i3dm whose glTF is given by uri, implicit tiling.
 #include <groundplan/gis/gltf.h>
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
@@ -47,7 +49,7 @@ struct Tiles3dInfo {
   bool by_feature = false;      // some content split its buildings by feature id
 };
 
-/// Reads a tileset.json, or one content file (.b3dm, .cmpt placed as the content of a tile with no
+/// Reads a tileset.json, or one content file (.b3dm, .i3dm, .cmpt placed as the content of a tile with no
 /// transform). Meshes go to `on_mesh` as the glTF reader gives them (GltfFrame::Ecef when placed on the
 /// Earth), on the calling thread, tile after tile in the tree's order: the tree is walked first (its
 /// JSON only), then the contents chosen are read, parsed and decoded side by side on the current TBB
