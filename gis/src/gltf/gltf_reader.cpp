@@ -232,7 +232,9 @@ class Reader {
     const tinygltf::Node& n = m_.nodes[i];
     const Mat4 world = detail::multiply(parent, node_matrix(n));
     const std::string& name = n.name.empty() ? named : n.name;
-    if (n.mesh >= 0) emit(name.empty() ? "node " + std::to_string(index) : name, n, world);
+    // An unnamed node in a tile is named after the tile too: "node N" alone repeats in every tile.
+    const std::string unnamed = (tile_ ? tile_->feature_prefix + " " : std::string()) + "node " + std::to_string(index);
+    if (n.mesh >= 0) emit(name.empty() ? unnamed : name, n, world);
     for (int c : n.children) visit(c, world, depth + 1, name);
     on_stack_[i] = false;
   }

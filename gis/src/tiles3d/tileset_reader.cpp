@@ -17,6 +17,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <unordered_map>
 
 namespace groundplan::gis {
 namespace {
@@ -134,7 +135,16 @@ class Walker {
     info_.contents += d.info.contents;
     if (!d.info.georeference.empty()) info_.georeference = d.info.georeference;
     info_.by_feature = info_.by_feature || d.info.by_feature;
-    for (auto& [mesh, frame] : d.meshes) cb_(std::move(mesh), frame);
+    for (auto& [mesh, frame] : d.meshes) {
+      // A building id of an earlier content: the same building twice (in two levels of an ADD tileset, or cut
+      // between tiles). Both are read, and said, as CityGML's repeated gml:id is.
+      auto [at, fresh] = delivered_.emplace(mesh.source_id, d.file);
+      if (!fresh && at->second != d.file)
+        problems_.push_back(Problem{mesh.source_id, d.file, "read", "DUPLICATE_ID",
+                                    "building id \"" + mesh.source_id + "\" is also in " + at->second +
+                                        " (the same building at two levels of an ADD tileset, or cut between tiles): both are read"});
+      cb_(std::move(mesh), frame);
+    }
     d.meshes.clear();
   }
 
@@ -324,6 +334,7 @@ class Walker {
   bool vsi_ = false;
   std::vector<std::string> stack_;  // tilesets being read, root first
   std::vector<Job> jobs_;           // the contents chosen, in tile order
+  std::unordered_map<std::string, std::string> delivered_;  // building id -> the content that gave it first
 };
 
 }  // namespace

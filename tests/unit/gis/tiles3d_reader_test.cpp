@@ -244,6 +244,22 @@ TEST(Tiles3d, AddTakesEveryLevel) {
   expect_plans_of_citygml(r, kFloat32Tolerance, "add");
 }
 
+TEST(Tiles3d, TheSameBuildingInTwoContentsIsSaid) {
+  // ADD with the whole city in the parent and the west half again in the child: the west buildings come
+  // twice (ADD means both levels), and each repeat is a DUPLICATE_ID problem naming the building.
+  test::TempDir d("gp_3dtiles");
+  d.file("all.b3dm", slurp(tiles("levels/all.b3dm")));
+  d.file("west.b3dm", slurp(tiles("levels/west.b3dm")));
+  nlohmann::json ts = nlohmann::json::parse(slurp(tiles("levels/add.json")));
+  ts["root"]["content"]["uri"] = "all.b3dm";
+  ts["root"]["children"][0]["content"]["uri"] = "west.b3dm";
+  const test::Read r = test::read(d.file("add.json", ts.dump()));
+  EXPECT_EQ(r.meshes.size(), kBuildings + 40);
+  EXPECT_EQ(r.count("DUPLICATE_ID"), 40u) << r.all();
+  for (const Problem& p : r.problems)
+    if (p.code == "DUPLICATE_ID") EXPECT_NE(p.reason.find(p.source_id), std::string::npos) << p.reason;
+}
+
 TEST(Tiles3d, GeometricErrorChoosesTheLevel) {
   // The parent's geometricError is 500: allowing 600 m stops there (all.b3dm), 100 m goes down to the leaves.
   CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "600");
