@@ -4,6 +4,7 @@
 #include <groundplan/error.h>
 #include <groundplan/gis/tiles3d.h>
 
+#include "tiles3d/implicit_tiling.h"
 #include "tiles3d/tile_content.h"
 #include "xml/safe_xml.h"
 #include "collada/collada_internal.h"
@@ -278,9 +279,7 @@ class Walker {
       const std::string r = lower(t["refine"].get<std::string>());
       if (r == "add" || r == "replace") refine = r == "add" ? "ADD" : "REPLACE";
     }
-    if (t.contains("implicitTiling"))
-      problem(tileset_path, "NOT_SUPPORTED",
-              "a tile uses implicit tiling (subtree files), which is not read: its implicit descendants are left out");
+    if (t.contains("implicitTiling")) return implicit(tileset_path, t, world, refine);
     const bool has_children = t.contains("children") && t["children"].is_array() && !t["children"].empty();
     const double error = t.contains("geometricError") && t["geometricError"].is_number() ? t["geometricError"].get<double>() : 0;
     const bool stop = !has_children || (opt_.geometric_error >= 0 && error <= opt_.geometric_error);
@@ -311,6 +310,43 @@ class Walker {
     }
     if (stop) return;
     for (const auto& child : t["children"]) tile(tileset_path, child, world, refine, depth + 1);
+  }
+
+  /// A tile with implicit tiling: its available descendants (subtree files) chosen as explicit tiles are.
+  void implicit(const std::string& tileset_path, const nlohmann::json& t, const Mat4& world, const std::string& refine) {
+    tiles3d::ImplicitTiling tiling;
+    const std::string why = tiles3d::parse_implicit(t, tiling);
+    if (!why.empty()) return problem(tileset_path, "BAD_TILE", "a tile with implicit tiling is skipped: " + why);
+    const double root_error = t.contains("geometricError") && t["geometricError"].is_number() ? t["geometricError"].get<double>() : 0;
+    auto load = [&](const std::string& from, const std::string& uri, std::string& path) {
+      path = resolve(from, uri);  // a uri outside the tileset or on the network: a problem there, and not read
+      if (path.empty()) throw InputError(from + ": subtree file \"" + uri.substr(0, 200) + "\" is not read");
+      xml::ByteBudget budget;
+      budget.max_entry_bytes = budget.max_total_bytes = opt_.max_json_bytes;
+      return xml::read_vsi_file(path, path, budget);
+    };
+    auto visit = [&](const tiles3d::ImplicitTile& it) {
+      if (it.level > 0 && ++info_.tiles > opt_.max_tiles) {  // level 0 is the explicit tile, counted already
+        if (info_.tiles == opt_.max_tiles + 1)
+          problem(tileset_path, "TOO_MANY_TILES", "more than " + std::to_string(opt_.max_tiles) + " tiles: the rest is not read");
+        return false;
+      }
+      const double error = root_error / std::ldexp(1.0, it.level);  // halved at each level
+      const bool stop = !it.has_children || (opt_.geometric_error >= 0 && error <= opt_.geometric_error);
+      if (it.has_content) {
+        if (stop || refine == "ADD") {
+          const std::string uri = tiles3d::expand(tiling.content, it);
+          const std::string file = resolve(tileset_path, uri);
+          if (!file.empty()) jobs_.push_back(Job{file, uri, world});
+        } else {
+          ++info_.skipped_by_level;
+        }
+      }
+      return !stop;
+    };
+    std::vector<std::pair<std::string, std::string>> failed;
+    tiles3d::walk_implicit(tiling, tileset_path, load, visit, failed);
+    for (const auto& [file, what] : failed) problem(file, "UNREADABLE_SUBTREE", what + ": the tiles below it are left out");
   }
 
   void external(const std::string& from, const std::string& file, const Mat4& world, const std::string& refine, int depth) {

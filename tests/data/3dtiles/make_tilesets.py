@@ -232,7 +232,7 @@ def main():
     east = [b for b in blds if b not in west]
     names = lambda bs: [b[0] for b in bs]
     out = HERE
-    for sub in ("b3dm", "glb", "draco", "meshopt", "levels", "i3dm"):
+    for sub in ("b3dm", "glb", "draco", "meshopt", "levels", "i3dm", "implicit"):
         shutil.rmtree(os.path.join(out, sub), ignore_errors=True)
 
     # 1.0: root translated to the centre; the west tile turned to ENU there (transforms composed); the east tile
@@ -257,6 +257,35 @@ def main():
     write(os.path.join(lv, "replace.json"),
           tileset(tile("all.b3dm", 500, enu, refine="REPLACE", children=[tile("west.b3dm", 0), tile("east.b3dm", 0)])))
     write(os.path.join(lv, "add.json"), tileset(tile("west.b3dm", 500, enu, refine="ADD", children=[tile("east.b3dm", 0)])))
+
+    # Implicit tiling (3D Tiles 1.1, QUADTREE, 2 levels in one binary subtree): level 0 all buildings (REPLACE),
+    # level 1 three quadrants around the centre (a building by its mean point), content/{level}/{x}/{y}.b3dm.
+    im = os.path.join(out, "implicit")
+    write(os.path.join(im, "content", "0", "0", "0.b3dm"), b3dm(batched_glb(*mesh_of(blds, to_enu)), names(blds)))
+    quads = {}
+    for b in blds:
+        m = to_enu(np.array(TO_ECEF.transform(*np.array([p for rs in b[1] for rg in rs for p in rg]).mean(0))))
+        quads.setdefault((int(m[0] >= 0), int(m[1] >= 0)), []).append(b)
+    # Tile (x 0, y 1) is not available: its buildings go with tile (0, 0), so that availability is not symmetric in
+    # x and y (a reader that swapped them would ask for content/1/0/1.b3dm, which is not there).
+    quads[(0, 0)] = quads.get((0, 0), []) + quads.pop((0, 1), [])
+    bits = 1  # the root
+    for (x, y), bs in sorted(quads.items()):
+        write(os.path.join(im, "content", "1", str(x), f"{y}.b3dm"), b3dm(batched_glb(*mesh_of(bs, to_enu)), names(bs)))
+        bits |= 1 << (1 + (x | (y << 1)))  # level 1 starts at bit 1, tiles in Morton order
+    avail = bytes([bits])
+    sj = json.dumps({"buffers": [{"byteLength": 8}], "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 1}],
+                     "tileAvailability": {"bitstream": 0}, "contentAvailability": [{"bitstream": 0}],
+                     "childSubtreeAvailability": {"constant": 0}}).encode()
+    sj += b" " * ((-len(sj)) % 8)
+    sb = pad(avail, 8)
+    write(os.path.join(im, "subtrees", "0", "0", "0.subtree"), struct.pack("<4sIQQ", b"subt", 1, len(sj), len(sb)) + sj + sb)
+    write(os.path.join(im, "tileset.json"), {
+        "asset": {"version": "1.1"}, "geometricError": 1000,
+        "root": {"boundingVolume": {"sphere": [0, 0, 0, 1e4]}, "geometricError": 500, "refine": "REPLACE",
+                 "transform": enu, "content": {"uri": "content/{level}/{x}/{y}.b3dm"},
+                 "implicitTiling": {"subdivisionScheme": "QUADTREE", "subtreeLevels": 2, "availableLevels": 2,
+                                    "subtrees": {"uri": "subtrees/{level}/{x}/{y}.subtree"}}}})
 
     # i3dm: one building as a model in east-north-up at its own centre, instanced there and 100 m east.
     b0 = west[0]

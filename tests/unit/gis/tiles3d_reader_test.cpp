@@ -257,7 +257,9 @@ TEST(Tiles3d, TheSameBuildingInTwoContentsIsSaid) {
   EXPECT_EQ(r.meshes.size(), kBuildings + 40);
   EXPECT_EQ(r.count("DUPLICATE_ID"), 40u) << r.all();
   for (const Problem& p : r.problems)
-    if (p.code == "DUPLICATE_ID") EXPECT_NE(p.reason.find(p.source_id), std::string::npos) << p.reason;
+    if (p.code == "DUPLICATE_ID") {
+      EXPECT_NE(p.reason.find(p.source_id), std::string::npos) << p.reason;
+    }
 }
 
 TEST(Tiles3d, GeometricErrorChoosesTheLevel) {
@@ -277,6 +279,66 @@ TEST(Tiles3d, GeometricErrorChoosesTheLevel) {
   EXPECT_EQ(fine.meshes.size(), kBuildings);
   EXPECT_EQ(fine.info.tiles3d.contents, 2u);
   EXPECT_EQ(fine.info.tiles3d.skipped_by_level, 1u);
+}
+
+TEST(Tiles3d, ImplicitQuadtreeTakesTheAvailableLeaves) {
+  // implicit/: QUADTREE, 2 levels in one binary subtree; level 0 every building, level 1 three quadrants
+  // (tile x 0, y 1 not available: its buildings are in tile 0, 0).
+  const gis::PipelineResult r = run(tiles("implicit/tileset.json"));
+  EXPECT_EQ(r.footprints.size(), kBuildings) << problems(r);
+  EXPECT_EQ(ids(r), building_ids());
+  expect_plans_of_citygml(r, kFloat32Tolerance, "implicit");
+  gis::ReadOptions opt;
+  const test::Read leaves = test::read(tiles("implicit/tileset.json"), opt);
+  EXPECT_EQ(leaves.info.tiles3d.contents, 3u);
+  EXPECT_EQ(leaves.info.tiles3d.skipped_by_level, 1u);
+  EXPECT_EQ(leaves.info.tiles3d.tiles, 4u);
+  // The root's geometricError is 500, level 1's 250: 600 m stops at the root.
+  CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "600");
+  const test::Read root = test::read(tiles("implicit/tileset.json"), opt);
+  CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", nullptr);
+  EXPECT_EQ(root.info.tiles3d.contents, 1u);
+  EXPECT_EQ(root.meshes.size(), kBuildings);
+}
+
+TEST(Tiles3dHostile, ShortBitstreamsAndBadSubtreesAreProblems) {
+  test::TempDir d("gp_3dtiles");
+  const nlohmann::json ts = nlohmann::json::parse(slurp(tiles("implicit/tileset.json")));
+  d.file("tileset.json", ts.dump());
+  d.file("content/0/0/0.b3dm", slurp(tiles("implicit/content/0/0/0.b3dm")));
+  auto subtree_says = [&](const std::string& subtree, const std::string& what) {
+    d.file("subtrees/0/0/0.subtree", subtree);
+    const test::Read r = test::read((d.path / "tileset.json").string());
+    bool said = false;
+    for (const Problem& p : r.problems)
+      said = said || (p.code == "UNREADABLE_SUBTREE" && p.reason.find(what) != std::string::npos);
+    EXPECT_TRUE(said) << what << "\n" << r.all();
+    EXPECT_TRUE(r.meshes.empty());
+  };
+  // A JSON subtree whose tile availability bitstream has 0 bytes for its 5 tiles.
+  d.file("subtrees/0/0/a.bin", std::string(1, '\x1f'));  // a subtree's buffer uri is relative to the subtree
+  subtree_says(R"({"buffers":[{"uri":"a.bin","byteLength":1}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":0}],)"
+               R"("tileAvailability":{"bitstream":0},"childSubtreeAvailability":{"constant":0}})",
+               "short bitstream");
+  // A binary subtree whose header claims more JSON than there is, and one cut inside its header.
+  const std::string good = slurp(tiles("implicit/subtrees/0/0/0.subtree"));
+  std::string lying = good;
+  const std::uint64_t huge = 1ull << 40;
+  std::memcpy(lying.data() + 8, &huge, 8);
+  subtree_says(lying, "the file has");
+  subtree_says(good.substr(0, 10), "truncated subtree");
+  // A bufferView past its buffer; a buffer outside the tileset's folder.
+  subtree_says(R"({"buffers":[{"uri":"a.bin","byteLength":1}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":9}],)"
+               R"("tileAvailability":{"bitstream":0},"childSubtreeAvailability":{"constant":0}})",
+               "reaches past its buffer");
+  subtree_says(R"({"buffers":[{"uri":"../../../../a.bin","byteLength":1}],"bufferViews":[],)"
+               R"("tileAvailability":{"constant":1},"childSubtreeAvailability":{"constant":0}})",
+               "is not read");
+  // Absurd levels: a problem, not 4^30 loops.
+  nlohmann::json deep = ts;
+  deep["root"]["implicitTiling"]["subtreeLevels"] = 30;
+  const test::Read r = test::read(d.file("tileset.json", deep.dump()));
+  EXPECT_EQ(r.count("BAD_TILE"), 1u) << r.all();
 }
 
 // --- georeference -----------------------------------------------------------------------------------

@@ -18,8 +18,10 @@
 // leaves the root tileset's folder (.., an absolute path, a symbolic link out) is never read, external
 // tilesets that include themselves are cut, transforms that are not finite or not a placement on the
 // Earth are refused, and every header length of b3dm/cmpt is checked against the bytes there are: each
-// is a Problem naming the tile, and the other tiles are read. Not read (a Problem says so): pnts
-// (points), an i3dm whose glTF is given by uri, implicit tiling.
+// is a Problem naming the tile, and the other tiles are read; so are subtree files whose bitstreams are
+// shorter than their levels need. Implicit tiling (QUADTREE, OCTREE; binary or JSON subtrees): its
+// available tiles are chosen as explicit ones are, the geometric error halved at each level. Not read (a
+// Problem says so): pnts (points), an i3dm whose glTF is given by uri.
 #include <groundplan/gis/gltf.h>
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
