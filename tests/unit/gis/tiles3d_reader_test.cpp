@@ -219,6 +219,39 @@ TEST(Tiles3d, KhrMeshoptCodecThisMeshoptimizerCannotDecodeIsAClearProblem) {
   EXPECT_TRUE(said) << r.all();
 }
 
+TEST(Tiles3d, MultipleContentsCompositeAndIdField) {
+  // levels/west.b3dm and east.b3dm share the east-north-up frame of replace.json's root: as 1.1's two
+  // contents of one tile, and as the two inner tiles of one cmpt (written here: a 16-byte header, the tiles).
+  test::TempDir d("gp_3dtiles");
+  const std::string west = slurp(tiles("levels/west.b3dm")), east = slurp(tiles("levels/east.b3dm"));
+  d.file("west.b3dm", west);
+  d.file("east.b3dm", east);
+  std::string cmpt = "cmpt";
+  for (std::uint32_t v : {1u, static_cast<std::uint32_t>(16 + west.size() + east.size()), 2u})
+    cmpt.append(reinterpret_cast<const char*>(&v), 4);
+  d.file("both.cmpt", cmpt + west + east);
+  nlohmann::json ts = nlohmann::json::parse(slurp(tiles("levels/replace.json")));
+  ts["asset"]["version"] = "1.1";
+  ts["root"].erase("children");
+  ts["root"].erase("content");
+  ts["root"]["contents"] = nlohmann::json::array({{{"uri", "west.b3dm"}}, {{"uri", "east.b3dm"}}});
+  const gis::PipelineResult multiple = run(d.file("multiple.json", ts.dump()));
+  EXPECT_EQ(multiple.footprints.size(), kBuildings) << problems(multiple);
+  EXPECT_EQ(ids(multiple), building_ids());
+  expect_plans_of_citygml(multiple, kFloat32Tolerance, "multiple contents");
+  ts["root"].erase("contents");
+  ts["root"]["content"] = {{"uri", "both.cmpt"}};
+  const gis::PipelineResult composite = run(d.file("composite.json", ts.dump()));
+  EXPECT_EQ(composite.footprints.size(), kBuildings) << problems(composite);
+  EXPECT_EQ(ids(composite), building_ids());
+  EXPECT_EQ(test::plan_keys(composite.plans), test::plan_keys(multiple.plans));
+  // --id-field naming a property the batch tables lack: the buildings are "<tile uri>#<batch id>".
+  const gis::PipelineResult unnamed = run((d.path / "composite.json").string(), "height");
+  ASSERT_EQ(unnamed.footprints.size(), kBuildings);
+  for (const Footprint& f : unnamed.footprints) EXPECT_EQ(f.source_id.rfind("both.cmpt/", 0), 0u) << f.source_id;
+  EXPECT_EQ(ids(run((d.path / "composite.json").string(), "gml_id")), building_ids());
+}
+
 TEST(Tiles3d, NoFeatureIdsIsSaidInANote) {
   const gis::PipelineResult r = run(tiles("meshopt/nodes.json"));
   bool note = false;
