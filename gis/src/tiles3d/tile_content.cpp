@@ -59,16 +59,24 @@ nlohmann::json parse_json_section(const std::string& bytes, std::size_t at, std:
   }
 }
 
+/// The byteLength of a b3dm or i3dm tile (`kind`) once its header's size, version and byteLength are checked
+/// against the bytes there are.
+std::uint32_t checked_length(const std::string& path, const std::string& b, const std::string& kind, std::size_t header) {
+  if (b.size() < header)
+    throw InputError(path + ": truncated " + kind + ": " + std::to_string(b.size()) + " bytes, its header alone takes " +
+                     std::to_string(header));
+  const std::uint32_t version = u32(b, 4), length = u32(b, 8);
+  if (version != 1) throw InputError(path + ": " + kind + " version " + std::to_string(version) + " is not read (only 1)");
+  if (length > b.size())
+    throw InputError(path + ": its " + kind + " header says " + std::to_string(length) + " bytes, the tile has " +
+                     std::to_string(b.size()) + " (truncated, or a lying byteLength)");
+  return length;
+}
+
 void read_b3dm(const std::string& path, const std::string& label, const std::string& b, const std::string& root_folder,
                const Mat4& transform, const Tiles3dOptions& options, const GltfMeshCallback& on_mesh,
                std::vector<Problem>& problems, Tiles3dInfo& info) {
-  if (b.size() < 28)
-    throw InputError(path + ": truncated b3dm: " + std::to_string(b.size()) + " bytes, its header alone takes 28");
-  const std::uint32_t version = u32(b, 4), length = u32(b, 8);
-  if (version != 1) throw InputError(path + ": b3dm version " + std::to_string(version) + " is not read (only 1)");
-  if (length > b.size())
-    throw InputError(path + ": its b3dm header says " + std::to_string(length) + " bytes, the tile has " +
-                     std::to_string(b.size()) + " (truncated, or a lying byteLength)");
+  const std::uint32_t length = checked_length(path, b, "b3dm", 28);
   std::uint64_t header = 28, ftj = u32(b, 12), ftb = u32(b, 16), btj = u32(b, 20), btb = u32(b, 24);
   // Two legacy headers (before 3D Tiles 1.0) are told apart by a length that would be absurd.
   if (btj >= 570425344u) header = 20, btj = u32(b, 16), ftj = ftb = btb = 0;
@@ -158,13 +166,7 @@ std::array<double, 3> oct32p(const unsigned char* p, std::size_t i) {
 void read_i3dm(const std::string& path, const std::string& label, const std::string& b, const std::string& root_folder,
                const Mat4& transform, const Tiles3dOptions& options, const GltfMeshCallback& on_mesh,
                std::vector<Problem>& problems, Tiles3dInfo& info) {
-  if (b.size() < 32)
-    throw InputError(path + ": truncated i3dm: " + std::to_string(b.size()) + " bytes, its header alone takes 32");
-  const std::uint32_t version = u32(b, 4), length = u32(b, 8);
-  if (version != 1) throw InputError(path + ": i3dm version " + std::to_string(version) + " is not read (only 1)");
-  if (length > b.size())
-    throw InputError(path + ": its i3dm header says " + std::to_string(length) + " bytes, the tile has " +
-                     std::to_string(b.size()) + " (truncated, or a lying byteLength)");
+  const std::uint32_t length = checked_length(path, b, "i3dm", 32);
   const std::uint64_t ftj = u32(b, 12), ftb = u32(b, 16), btj = u32(b, 20), btb = u32(b, 24);
   if (32 + ftj + ftb + btj + btb > length)
     throw InputError(path + ": its i3dm feature and batch tables (" + std::to_string(ftj + ftb + btj + btb) +
