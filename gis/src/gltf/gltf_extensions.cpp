@@ -211,6 +211,7 @@ std::vector<std::string> unknown_required_extensions(const tinygltf::Model& mode
   for (const std::string& e : model.extensionsRequired) {
     const bool known = e == kDraco || e == kMeshoptExt || e == kMeshoptKhr || e == "KHR_mesh_quantization" ||
                        e == "CESIUM_RTC" || e == "EXT_mesh_features" || e == "EXT_structural_metadata" ||
+                       e == "EXT_mesh_gpu_instancing" || e == "EXT_instance_features" ||
                        starts_with(e, "KHR_materials_") || starts_with(e, "KHR_texture_") ||
                        starts_with(e, "EXT_texture_");
     if (!known) out.push_back(e);

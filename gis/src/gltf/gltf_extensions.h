@@ -24,7 +24,8 @@ namespace groundplan::gis::gltf {
 std::string loadable_json(std::string_view json);
 
 /// The extensions the file requires that groundplan does not read (anything but the compression and
-/// quantization extensions above, CESIUM_RTC, EXT_mesh_features, EXT_structural_metadata and those of
+/// quantization extensions above, CESIUM_RTC, EXT_mesh_features, EXT_structural_metadata,
+/// EXT_mesh_gpu_instancing, EXT_instance_features and those of
 /// materials and textures, which do not change geometry): reading it anyway would give wrong shapes.
 std::vector<std::string> unknown_required_extensions(const tinygltf::Model& model);
 

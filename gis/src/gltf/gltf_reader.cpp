@@ -203,9 +203,9 @@ class Reader {
     for (int r : roots) visit(r, root, 0, std::string());
     // Buildings by feature: delivered once the whole glTF is read (a feature may span nodes and primitives).
     for (std::size_t k = 0; k < feature_order_.size(); ++k) deliver(std::move(features_[feature_order_[k]]));
-    if (!feature_order_.empty()) info_.by_feature = true;
+    if (!feature_order_.empty() || by_instance_) info_.by_feature = true;
     if (info_.meshes == 0) problem("", "NO_GEOMETRY", "the glTF scene holds no triangle geometry");
-    else if (tile_ && feature_order_.empty() && info_.meshes > 0)
+    else if (tile_ && feature_order_.empty() && !by_instance_ && info_.meshes > 0)
       problem("", "NOTE", "no feature ids (_BATCHID, EXT_mesh_features): one building per glTF node with a mesh");
   }
 
@@ -372,6 +372,7 @@ class Reader {
       problem(id, "BAD_TRANSFORM", "the node's transform holds NaN or infinity");
       return;
     }
+    if (instanced(id, n, world)) return;
     Mesh mesh;
     mesh.source_id = id;
     mesh.name = m_.meshes[static_cast<std::size_t>(n.mesh)].name;
@@ -382,6 +383,84 @@ class Reader {
       if (stopped_) break;
     }
     deliver(std::move(mesh));
+  }
+
+  /// EXT_mesh_gpu_instancing: the node's mesh once per instance (TRANSLATION, ROTATION, SCALE in the node's
+  /// frame), each instance one building, named by its EXT_instance_features id in the property table, else
+  /// "<node> #<instance>". False when the node is not instanced.
+  bool instanced(const std::string& id, const tinygltf::Node& n, const Mat4& world) {
+    auto ext = n.extensions.find("EXT_mesh_gpu_instancing");
+    if (ext == n.extensions.end()) return false;
+    const tinygltf::Value& attrs = ext->second.Get("attributes");
+    struct Attr {
+      const unsigned char* base = nullptr;
+      std::size_t stride = 0, size = 0;
+      int type = 0;
+      bool normalized = false, present = false;
+      double at(std::size_t i, int k) const { return component(base + i * stride + static_cast<std::size_t>(k) * size, type, normalized); }
+    };
+    std::size_t count = 0;
+    bool counted = false;
+    auto get = [&](const std::string& name, int width, Attr& out) -> std::string {
+      if (!attrs.IsObject() || !attrs.Has(name)) return {};
+      const tinygltf::Value& v = attrs.Get(name);
+      const int ai = v.IsNumber() ? v.GetNumberAsInt() : -1;
+      if (ai < 0 || static_cast<std::size_t>(ai) >= m_.accessors.size()) return name + ": accessor index out of range";
+      const tinygltf::Accessor& a = m_.accessors[static_cast<std::size_t>(ai)];
+      const int want = width == 1 ? TINYGLTF_TYPE_SCALAR : width == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4;
+      out.size = component_size(a.componentType);
+      if (a.type != want || out.size == 0) return name + " is not of the type the extension says";
+      std::string why;
+      if (!view(a, out.size * static_cast<std::size_t>(width), out.base, out.stride, why)) return name + ": " + why;
+      if (counted && a.count != count) return "its attributes differ in count";
+      count = a.count, counted = true, out.type = a.componentType, out.normalized = a.normalized, out.present = true;
+      return {};
+    };
+    Attr t, r, sc, fid;
+    int table = -1;
+    std::string why = get("TRANSLATION", 3, t);
+    if (why.empty()) why = get("ROTATION", 4, r);
+    if (why.empty()) why = get("SCALE", 3, sc);
+    auto features = n.extensions.find("EXT_instance_features");
+    if (why.empty() && features != n.extensions.end() && features->second.Get("featureIds").IsArray() &&
+        features->second.Get("featureIds").ArrayLen() > 0) {
+      const tinygltf::Value& set = features->second.Get("featureIds").Get(0);
+      if (set.Get("attribute").IsNumber()) why = get("_FEATURE_ID_" + std::to_string(set.Get("attribute").GetNumberAsInt()), 1, fid);
+      if (set.Get("propertyTable").IsNumber()) table = set.Get("propertyTable").GetNumberAsInt();
+    }
+    if (!why.empty()) {
+      problem(id, "BAD_PRIMITIVE", "EXT_mesh_gpu_instancing: " + why + ": the node's instances are skipped");
+      return true;
+    }
+    const tinygltf::Mesh& gm = m_.meshes[static_cast<std::size_t>(n.mesh)];
+    for (std::size_t i = 0; i < count && !stopped_; ++i) {
+      tinygltf::Node place;  // the instance's TRS, turned into a matrix as a node's is
+      if (t.present) place.translation = {t.at(i, 0), t.at(i, 1), t.at(i, 2)};
+      if (r.present) place.rotation = {r.at(i, 0), r.at(i, 1), r.at(i, 2), r.at(i, 3)};
+      if (sc.present) place.scale = {sc.at(i, 0), sc.at(i, 1), sc.at(i, 2)};
+      const Mat4 m = detail::multiply(world, node_matrix(place));
+      const double f = fid.present ? fid.at(i, 0) : -1;
+      std::string name = f >= 0 && table >= 0 ? table_string(table, static_cast<std::int64_t>(f)) : std::string();
+      if (name.empty()) name = id + " #" + std::to_string(i);
+      if (!finite(m)) {
+        problem(name, "BAD_TRANSFORM", "the instance's transform holds NaN or infinity");
+        continue;
+      }
+      Mesh mesh;
+      mesh.source_id = name;
+      mesh.name = gm.name;
+      mesh.source_file = path_;
+      instancing_ = true;  // the mesh's own feature ids would join the instances: one building an instance
+      for (const tinygltf::Primitive& pr : gm.primitives) {
+        std::string bad;
+        if (!primitive(pr, m, mesh, name, bad)) problem(name, "BAD_PRIMITIVE", "a primitive is skipped: " + bad);
+        if (stopped_) break;
+      }
+      instancing_ = false;
+      if (!mesh.faces.empty()) by_instance_ = true;
+      deliver(std::move(mesh));
+    }
+    return true;
   }
 
   void deliver(Mesh&& mesh) {
@@ -439,7 +518,7 @@ class Reader {
       for (std::size_t k = 0; k < pa.count; ++k) idx[k] = static_cast<std::uint32_t>(k);
     }
     // Feature ids, one per vertex: the primitive's triangles go to the building of their first vertex.
-    const FeatureIdSet fs = feature_ids(pr);
+    const FeatureIdSet fs = instancing_ ? FeatureIdSet{} : feature_ids(pr);
     std::vector<std::int64_t> fid;
     if (fs.accessor >= 0) {
       if (static_cast<std::size_t>(fs.accessor) >= m_.accessors.size()) return why = "feature id accessor is out of range", false;
@@ -514,6 +593,8 @@ class Reader {
   std::vector<bool> on_stack_;
   Point3 rtc_;
   bool has_rtc_ = false, stopped_ = false;
+  bool instancing_ = false;   // an EXT_mesh_gpu_instancing instance is being read
+  bool by_instance_ = false;  // some node was instanced: its buildings are its instances
   std::size_t total_vertices_ = 0;
   std::unordered_map<std::string, Mesh> features_;  // building by "table:feature id"
   std::vector<std::string> feature_order_;          // in the order first met
@@ -620,7 +701,8 @@ void read_gltf_instances(const std::string& path, const std::string& bytes_in, c
     throw InputError(path + ": requires the glTF extension" + (unknown.size() > 1 ? "s " : " ") + list +
                      ", which groundplan does not read (its geometry would come out wrong); supported: "
                      "KHR_draco_mesh_compression, EXT_meshopt_compression, KHR_meshopt_compression, "
-                     "KHR_mesh_quantization, CESIUM_RTC, EXT_mesh_features, EXT_structural_metadata, and the "
+                     "KHR_mesh_quantization, CESIUM_RTC, EXT_mesh_features, EXT_structural_metadata, EXT_mesh_gpu_instancing, "
+                     "EXT_instance_features, and the "
                      "material and texture extensions (ignored)");
   }
   std::vector<std::string> decode_problems;

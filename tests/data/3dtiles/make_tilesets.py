@@ -232,7 +232,7 @@ def main():
     east = [b for b in blds if b not in west]
     names = lambda bs: [b[0] for b in bs]
     out = HERE
-    for sub in ("b3dm", "glb", "draco", "meshopt", "levels", "i3dm", "implicit"):
+    for sub in ("b3dm", "glb", "draco", "meshopt", "levels", "i3dm", "i3dm_glb", "implicit"):
         shutil.rmtree(os.path.join(out, sub), ignore_errors=True)
 
     # 1.0: root translated to the centre; the west tile turned to ENU there (transforms composed); the east tile
@@ -305,6 +305,9 @@ def main():
         # 1.1: the b3dm tileset upgraded by 3d-tiles-tools (b3dm -> glb with EXT_mesh_features / EXT_structural_metadata).
         subprocess.run([os.path.join(bin_dir, "3d-tiles-tools"), "upgrade", "-i", os.path.join(out, "b3dm", "tileset.json"),
                         "-o", os.path.join(out, "glb"), "--targetVersion", "1.1", "-f"], check=True)
+        # The i3dm tileset upgraded too: glb with EXT_mesh_gpu_instancing and EXT_instance_features.
+        subprocess.run([os.path.join(bin_dir, "3d-tiles-tools"), "upgrade", "-i", os.path.join(out, "i3dm", "tileset.json"),
+                        "-o", os.path.join(out, "i3dm_glb"), "--targetVersion", "1.1", "-f"], check=True)
         # Draco: every glb of the 1.1 tileset compressed by gltf-pipeline, positions quantized to 24 bits (0.1 mm
         # steps over a tile: its default, 11 bits, moves walls by decimetres).
         shutil.copytree(os.path.join(out, "glb"), os.path.join(out, "draco"))

@@ -374,6 +374,28 @@ TEST(Tiles3dHostile, ShortBitstreamsAndBadSubtreesAreProblems) {
   EXPECT_EQ(r.count("BAD_TILE"), 1u) << r.all();
 }
 
+TEST(Tiles3d, GpuInstancingGlbIsTheI3dmsInstances) {
+  // i3dm_glb/: 3d-tiles-tools' upgrade of instances.i3dm: a glb with EXT_mesh_gpu_instancing (required) and
+  // EXT_instance_features naming each instance through a property table. The same two buildings, where the
+  // i3dm puts them (1 mm: both float32 stores of the same numbers).
+  gis::ReadOptions opt;
+  opt.target_srs = "EPSG:25832";
+  const test::Read glb = test::read(tiles("i3dm_glb/tileset.json"), opt);
+  const test::Read i3dm = test::read(tiles("i3dm/tileset.json"), opt);
+  ASSERT_EQ(glb.meshes.size(), 2u) << glb.all();
+  ASSERT_EQ(i3dm.meshes.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(glb.meshes[k].source_id, i3dm.meshes[k].source_id);
+    double worst = 0;
+    for (const Point3& p : glb.meshes[k].vertices) {
+      double best = 1e300;
+      for (const Point3& q : i3dm.meshes[k].vertices) best = std::min(best, std::hypot(p.x - q.x, p.y - q.y, p.z - q.z));
+      worst = std::max(worst, best);
+    }
+    EXPECT_LE(worst, 1e-3) << glb.meshes[k].source_id;
+  }
+}
+
 // --- georeference -----------------------------------------------------------------------------------
 
 TEST(Tiles3d, VerticesLandWherePyprojPutsThem) {

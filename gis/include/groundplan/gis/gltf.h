@@ -13,7 +13,9 @@
 // 3D Tiles 1.0's _BATCHID), each feature is one building (one Mesh over every node and primitive),
 // named by its EXT_structural_metadata property table's gml_id, id or name (GltfOptions::id_field), else
 // "feature #N"; triangles go to the feature of their first vertex. Without feature ids: one Mesh per node,
-// named by the node, else by its nearest named ancestor, else "node N".
+// named by the node, else by its nearest named ancestor, else "node N". A node with EXT_mesh_gpu_instancing
+// gives one building per instance (its TRS in the node's frame), named by its EXT_instance_features id in the
+// property table, else "<node> #<instance>".
 //
 // Georeference: the CESIUM_RTC extension's ECEF centre is added to every position; a mesh whose
 // transformed positions lie at the Earth's radius (a 3D-Tiles-style ECEF root transform) is ECEF
