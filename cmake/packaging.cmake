@@ -11,7 +11,7 @@ add_library(libgroundplan SHARED ${CMAKE_SOURCE_DIR}/packaging/libgroundplan.cpp
                                   $<TARGET_OBJECTS:groundplan_gis> $<TARGET_OBJECTS:groundplan_geosref>)
 target_link_libraries(libgroundplan PRIVATE groundplan_flags PkgConfig::MPFR TBB::tbb PROJ::proj EXPAT::EXPAT
                                             GEOS::geos_c GDAL::GDAL groundplan_geographiclib PkgConfig::GMPXX simdjson::simdjson
-                                            pugixml::static)
+                                            pugixml::static draco::draco meshoptimizer::meshoptimizer)
 target_link_libraries(libgroundplan PRIVATE ${CMAKE_DL_LIBS})   # the CUDA module is loaded, not linked (gpu/)
 target_include_directories(libgroundplan INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
 set_target_properties(libgroundplan PROPERTIES OUTPUT_NAME groundplan VERSION ${PROJECT_VERSION}

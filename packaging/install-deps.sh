@@ -13,6 +13,8 @@ packages=(
   libmpfr-dev libgmp-dev
   # formats: streaming XML (CityGML, KML, COLLADA), glTF
   libexpat1-dev libtinygltf-dev
+  # compressed glTF (glTF inputs and 3D Tiles contents): Draco and meshopt decoders
+  libdraco-dev libmeshoptimizer-dev
   # CityGML files and chunks of up to 64 MiB parsed in memory, 4-5x expat's speed (issue 14)
   libpugixml-dev
   # CityJSON / CityJSONSeq (issue 16)

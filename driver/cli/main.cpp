@@ -97,7 +97,7 @@ std::optional<int> parse_command_line(int argc, char** argv, CommandLine& cl, Ra
   app.add_option("--input-sql", ogr_in.sql, "OGR source: SQL statement whose result layer is read");
   app.add_option("--input-dialect", ogr_in.dialect, "OGR source: dialect of --input-sql (OGRSQL, SQLITE)");
   app.add_option("--input-oo", ogr_in.open_options, "OGR source: NAME=VALUE open option of its driver (repeatable)");
-  app.add_option("--id-field", ogr_in.id_field, "OGR source: field holding the building id (default: the FID)");
+  app.add_option("--id-field", ogr_in.id_field, "OGR source: field holding the building id (default: the FID); glTF / 3D Tiles: the feature property naming a building (default: gml_id, id, name)");
   app.add_option("--group-by", ogr_in.group_by, "OGR source: features sharing this field's value are one building");
   app.add_option("--input-geom-field", ogr_in.geom_field,
                  "OGR source: the geometry field to read where a layer has several (default: the first)");

@@ -59,7 +59,7 @@ const char* open_option_list_xml() {
          "  <Option name='INPUT_SQL' type='string' description='OGR sources: SQL statement whose result layer is read'/>"
          "  <Option name='INPUT_DIALECT' type='string' description='OGR sources: dialect of INPUT_SQL (OGRSQL, SQLITE)'/>"
          "  <Option name='INPUT_OO' type='string' description='OGR sources: comma-separated NAME=VALUE open options of the source driver'/>"
-         "  <Option name='ID_FIELD' type='string' description='OGR sources: field holding the building id (default: the FID)'/>"
+         "  <Option name='ID_FIELD' type='string' description='OGR sources: field holding the building id (default: the FID); glTF / 3D Tiles: the feature property naming a building (default: gml_id, id, name)'/>"
          "  <Option name='GROUP_BY' type='string' description='OGR sources: features sharing this field&apos;s value are one building'/>"
          "  <Option name='INPUT_GEOM_FIELD' type='string' description='OGR sources: the geometry field to read where a layer has several (default: the first)'/>"
          "  <Option name='NUM_THREADS' type='string' description='Threads for every stage: a number or ALL_CPUS "

@@ -5,6 +5,7 @@
 #include <groundplan/gis/collada.h>
 #include <groundplan/gis/placement.h>
 #include <groundplan/gis/reader.h>
+#include <groundplan/gis/tiles3d.h>
 
 #include <cpl_conv.h>
 #include <cpl_vsi.h>
@@ -14,6 +15,7 @@
 #include "gzip_progress.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <optional>
 
@@ -39,11 +41,14 @@ std::string extension(const std::string& name) {
 InputFormat sniff(std::string_view head) {
   if (head.size() >= 4 && std::memcmp(head.data(), "PK\x03\x04", 4) == 0) return InputFormat::Kmz;
   if (head.size() >= 4 && std::memcmp(head.data(), "glTF", 4) == 0) return InputFormat::Glb;
+  for (const char* magic : {"b3dm", "cmpt", "i3dm", "pnts"})  // i3dm, pnts: the 3D Tiles reader says they are not read
+    if (head.size() >= 4 && std::memcmp(head.data(), magic, 4) == 0) return InputFormat::Tiles3d;
   const auto first = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
   if (first == std::string_view::npos) return InputFormat::Unknown;
   if (head[first] == '{') {
     bool sequence = false;
     if (looks_like_cityjson(head, &sequence)) return sequence ? InputFormat::CityJsonSeq : InputFormat::CityJson;
+    if (looks_like_tileset(head)) return InputFormat::Tiles3d;
     return head.find("\"asset\"") != std::string_view::npos ? InputFormat::Gltf : InputFormat::Unknown;
   }
   if (head[first] != '<') return InputFormat::Unknown;
@@ -82,6 +87,7 @@ const char* to_string(InputFormat f) {
     case InputFormat::CityJson: return "CityJSON";
     case InputFormat::CityJsonSeq: return "CityJSONSeq";
     case InputFormat::Ogr: return "OGR";
+    case InputFormat::Tiles3d: return "3D Tiles";
   }
   return "?";
 }
@@ -90,7 +96,7 @@ namespace {
 // The names a folder or a zip of tiles is expanded to: one list for the checks and for the messages that
 // name them. Gzip: the text formats, with ".gz" after them.
 constexpr std::string_view kInputSuffixes[] = {".gml", ".citygml", ".xml", ".kml", ".kmz", ".gltf", ".glb",
-                                               ".city.json", ".city.jsonl"};
+                                               ".b3dm", ".i3dm", ".cmpt", ".city.json", ".city.jsonl"};
 constexpr std::string_view kGzipSuffixes[] = {".gml", ".citygml", ".xml", ".kml", ".city.json", ".city.jsonl"};
 
 template <std::size_t N>
@@ -127,6 +133,9 @@ InputFormat detect_format(const std::string& gz_name, std::string_view head) {
   if (ext == ".dae") return InputFormat::Collada;
   if (ext == ".gltf") return InputFormat::Gltf;
   if (ext == ".glb") return InputFormat::Glb;
+  if (ext == ".b3dm" || ext == ".cmpt" || ext == ".i3dm" || ext == ".pnts") return InputFormat::Tiles3d;
+  if (lower(name) == "tileset.json" || ends_with(lower(name), "/tileset.json") || ends_with(lower(name), "\\tileset.json"))
+    return InputFormat::Tiles3d;
   if (ext == ".jsonl") return InputFormat::CityJsonSeq;  // the reader says when it is not CityJSONSeq
   if (ends_with(lower(name), ".city.json")) return InputFormat::CityJson;
   const InputFormat by_content = sniff(head);
@@ -160,7 +169,7 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     if (VSIStatL(path.c_str(), &st) != 0 && !looks_like_connection_string(path))
       throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
     throw InputError(path + ": format not recognised (CityGML .gml/.citygml/.xml, KML .kml/.kmz, glTF .gltf/.glb, "
-                            "COLLADA .dae, CityJSON .city.json/.json, CityJSONSeq .city.jsonl, and any vector format GDAL "
+                            "3D Tiles tileset.json/.b3dm/.cmpt, COLLADA .dae, CityJSON .city.json/.json, CityJSONSeq .city.jsonl, and any vector format GDAL "
                             "reads: none of them knows it)");
   }
   // A gzip input is read through /vsigzip/, and no further than gzip_max_ratio times its packed size.
@@ -261,6 +270,18 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
   };
   const std::string no_origin = ": has no georeference (no KML Location, no CESIUM_RTC, no ECEF transform): pass "
                                 "--origin lon,lat,alt (degrees, degrees, metres) to place its local frame";
+  // glTF and 3D Tiles: ECEF meshes placed by PROJ, local ones at --origin.
+  auto place_gltf = [&](Mesh&& mesh, GltfFrame frame) {
+    std::string reason;
+    bool ok = false;
+    if (frame == GltfFrame::Ecef) {
+      ok = geo.place_ecef(mesh, &reason);
+    } else {
+      if (!origin) throw InputError(path + no_origin);
+      ok = geo.place_local(mesh, *origin, &reason);
+    }
+    deliver(mesh, ok, reason);
+  };
 
   switch (info.format) {
     case InputFormat::Kml:
@@ -292,17 +313,35 @@ void read_any(const std::string& path, const ReadOptions& options, const MeshCal
     case InputFormat::Gltf:
     case InputFormat::Glb:
       try {
-        read_gltf(path, options.gltf, [&](Mesh&& mesh, GltfFrame frame) {
-          std::string reason;
-          bool ok = false;
-          if (frame == GltfFrame::Ecef) {
-            ok = geo.place_ecef(mesh, &reason);
-          } else {
-            if (!origin) throw InputError(path + no_origin);
-            ok = geo.place_local(mesh, *origin, &reason);
-          }
-          deliver(mesh, ok, reason);
-        }, problems, info.gltf);
+        read_gltf(path, options.gltf, place_gltf, problems, info.gltf);
+      } catch (...) {
+        finish();
+        throw;
+      }
+      break;
+    case InputFormat::Tiles3d:
+      try {
+        Tiles3dOptions topt = options.tiles3d;
+        topt.gltf = options.gltf;
+        // The level of detail by geometric error: a --config option, so that the CLI, the driver and Python have it.
+        if (const char* e = CPLGetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", nullptr)) {
+          char* end = nullptr;
+          const double v = std::strtod(e, &end);
+          if (end == e || *end != '\0' || !(v >= 0))
+            throw InvalidArgument(std::string("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR=") + e + ": not a number of metres >= 0");
+          topt.geometric_error = v;
+        }
+        // Progress over tiles: the tileset file's bytes told in shares, one a content.
+        VSIStatBufL st;
+        const std::uint64_t size = VSIStatL(path.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+        std::uint64_t told = 0;
+        auto progress = [&](std::size_t done, std::size_t total) {
+          const std::uint64_t now = total ? size * done / total : size;
+          if (options.on_bytes && now > told) options.on_bytes(now - told);
+          told = now;
+        };
+        read_3d_tiles(path, topt, place_gltf, problems, info.tiles3d, progress);
+        if (options.on_bytes && size > told) options.on_bytes(size - told);
       } catch (...) {
         finish();
         throw;

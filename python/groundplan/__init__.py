@@ -364,7 +364,8 @@ def read(
     """Reads building models and computes their ground plans: ``groundplan`` (the CLI) as a function.
 
     path_or_paths: a file or folder, or a list of them: CityGML (.gml, .xml, .gz), CityJSON / CityJSONSeq,
-        KML/KMZ with COLLADA, glTF/GLB, or any vector source OGR opens (GeoPackage, Shapefile ...).
+        KML/KMZ with COLLADA, glTF/GLB, 3D Tiles (tileset.json or its folder, .b3dm, .i3dm, .cmpt), or any vector
+        source OGR opens (GeoPackage, Shapefile ...).
     options: the GroundPlan driver's open options, as keywords (lower case) or as their own names:
         threads (NUM_THREADS), resolution, resolution_mode, device, footprints ("auto", "ground-surface",
         "decompose"), lod, t_srs, s_srs, a_srs, origin, axis_order, preset ("none", "cfd"), snap, close_gaps,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// KML/KMZ + COLLADA, glTF/GLB and CityJSON/CityJSONSeq (issue 16) readers on arbitrary bytes (issue 8), through read_any on a /vsimem/
+// KML/KMZ + COLLADA, glTF/GLB, CityJSON/CityJSONSeq (issue 16) and 3D Tiles (b3dm, cmpt, tileset.json) readers on arbitrary bytes (issue 8), through read_any on a /vsimem/
 // file: byte 0 picks the format (the extension), the rest is the file. A .kml may link "m.dae", which
 // is the same bytes again (so COLLADA is reached through KML too). Expected outcomes: meshes,
 // Problems, or an InputError; anything else is a finding.
@@ -25,9 +25,12 @@ void put(const std::string& path, const std::uint8_t* data, std::size_t size) {
 GROUNDPLAN_FUZZ_TARGET(read_any) {
   using namespace groundplan;
   if (size < 1) return 0;
-  static const char* kExt[] = {".kml", ".kmz", ".dae", ".gltf", ".glb", ".city.json", ".city.jsonl"};
+  // A tileset.json's contents name files beside it: "m.dae" is there (the same bytes), the rest is missing.
+  static const char* kExt[] = {".kml", ".kmz", ".dae", ".gltf", ".glb", ".city.json", ".city.jsonl", ".b3dm", ".cmpt",
+                               "/tileset.json"};
   const std::string dir = "/vsimem/fuzz_read_any";
-  const std::string path = dir + "/input" + kExt[data[0] % 7];
+  const std::string ext = kExt[data[0] % 10];
+  const std::string path = dir + (ext[0] == '/' ? ext : "/input" + ext);
   put(path, data + 1, size - 1);
   put(dir + "/m.dae", data + 1, size - 1);
   gis::ReadOptions options;

@@ -368,6 +368,7 @@ ReadOptions whole_read_options(const PipelineOptions& options, const ReadContext
   read_options.lod_refinement = options.lod_refinement;
   read_options.origin = options.origin;
   read_options.ogr = options.ogr_input;
+  read_options.gltf.id_field = options.ogr_input.id_field;  // glTF / 3D Tiles: the property naming a feature
   read_options.target_srs = context.working_definition;  // KML/glTF are placed by the reader, in this CRS
   return read_options;
 }

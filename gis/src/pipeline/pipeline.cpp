@@ -90,6 +90,11 @@ std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& i
   for (const std::string& in : inputs) {
     std::error_code ec;
     if (fs::is_directory(in, ec)) {
+      // A 3D Tiles folder: its tileset.json is the entry point (its tiles are read through it, not one by one).
+      if (fs::is_regular_file(fs::path(in) / "tileset.json", ec)) {
+        files.push_back((fs::path(in) / "tileset.json").string());
+        continue;
+      }
       std::vector<std::string> found;
       for (const auto& e : fs::directory_iterator(in, ec))
         if (e.is_regular_file() && (is_input_name(e.path().filename().string()) ||

@@ -375,7 +375,11 @@ TEST(CityJsonReader, DetectionAndFolderNames) {
   EXPECT_EQ(gis::detect_format("x.json", "{\n  \"version\": \"1.1\",\n  \"type\": \"CityJSON\"\n}"), gis::InputFormat::CityJson);
   EXPECT_EQ(gis::detect_format("x.json", "{\"type\":\"CityJSON\"}\n{\"type\":\"CityJSONFeature\"}"),
             gis::InputFormat::CityJsonSeq);
-  EXPECT_EQ(gis::detect_format("tileset.json", R"({"asset":{"version":"1.0"},"root":{}})"), gis::InputFormat::Gltf);
+  // A 3D Tiles tileset is neither CityJSON nor glTF (both also have "asset" or "version" keys).
+  EXPECT_EQ(gis::detect_format("tileset.json", R"({"asset":{"version":"1.0"},"root":{}})"), gis::InputFormat::Tiles3d);
+  EXPECT_EQ(gis::detect_format("x.json", R"({"asset":{"version":"1.1"},"geometricError":1,"root":{}})"),
+            gis::InputFormat::Tiles3d);
+  EXPECT_EQ(gis::detect_format("x.json", R"({"asset":{"version":"2.0"},"nodes":[]})"), gis::InputFormat::Gltf);
   EXPECT_EQ(gis::detect_format("x.json", R"({"type":"FeatureCollection"})"), gis::InputFormat::Unknown);
   EXPECT_TRUE(gis::is_input_name("a.city.json"));
   EXPECT_TRUE(gis::is_input_name("A.CITY.JSONL"));

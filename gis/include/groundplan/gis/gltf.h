@@ -5,6 +5,18 @@
 // TRIANGLE_STRIP, TRIANGLE_FAN; indexed or not) placed by the node transforms (matrix or TRS),
 // then turned from glTF's y-up to z-up as 3D Tiles does: (x, y, z) -> (x, -z, y).
 //
+// Compressed and quantized glTF (KHR_draco_mesh_compression, EXT_/KHR_meshopt_compression,
+// KHR_mesh_quantization) is decoded first; a file that requires any other extension that changes
+// geometry is refused with an InputError naming it.
+//
+// Buildings by feature: where a primitive has per-vertex feature ids (EXT_mesh_features by attribute,
+// 3D Tiles 1.0's _BATCHID), each feature is one building (one Mesh over every node and primitive),
+// named by its EXT_structural_metadata property table's gml_id, id or name (GltfOptions::id_field), else
+// "feature #N"; triangles go to the feature of their first vertex. Without feature ids: one Mesh per node,
+// named by the node, else by its nearest named ancestor, else "node N". A node with EXT_mesh_gpu_instancing
+// gives one building per instance (its TRS in the node's frame), named by its EXT_instance_features id in the
+// property table, else "<node> #<instance>".
+//
 // Georeference: the CESIUM_RTC extension's ECEF centre is added to every position; a mesh whose
 // transformed positions lie at the Earth's radius (a 3D-Tiles-style ECEF root transform) is ECEF
 // too. Anything else is in a local frame (x east, y north, z up, metres) that needs an origin.
@@ -16,6 +28,7 @@
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -27,6 +40,7 @@ struct GltfOptions {
   std::uint64_t max_bytes = std::uint64_t{1} << 30;  // the file plus its external buffers
   std::size_t max_vertices = 50'000'000;             // over all meshes
   int max_node_depth = 64;
+  std::string id_field;         // the property naming a feature (property table, batch table); "": gml_id, id, name
 };
 
 enum class GltfFrame {
@@ -41,6 +55,18 @@ struct GltfInfo {
   std::size_t meshes = 0;       // meshes delivered
   std::size_t primitives = 0;   // primitives read
   std::size_t faces = 0;
+  bool by_feature = false;      // buildings were split by feature id
+};
+
+/// How a 3D Tiles content places and names its glTF (tiles3d.h): ECEF = transform * RTC centre *
+/// (y-up to z-up) * node transforms.
+struct GltfTile {
+  std::array<double, 16> transform = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // row-major, z-up
+  bool has_rtc_center = false;  // a b3dm feature table's RTC_CENTER
+  Point3 rtc_center;
+  std::string feature_prefix;   // a feature without an id property is "<prefix>#<feature id>"
+  std::function<std::string(std::int64_t)> feature_name;  // a b3dm batch table's id of a feature; "" = none
+  std::string building;         // non-empty: the whole model is one building of this id (an i3dm instance)
 };
 
 /// Called once per node with a mesh; the mesh's frame says how to place it. May be moved from.
@@ -51,5 +77,17 @@ using GltfMeshCallback = std::function<void(Mesh&&, GltfFrame)>;
 /// the byte limit. Exceptions thrown by `on_mesh` propagate.
 void read_gltf(const std::string& path, const GltfOptions& options, const GltfMeshCallback& on_mesh,
                std::vector<Problem>& problems, GltfInfo& info);
+
+/// The same from bytes in memory (a GLB or glTF JSON; a 3D Tiles content's glTF). `path` names it in
+/// messages and locates its external buffers, which must lie under `root_folder`. `tile` may be null.
+void read_gltf_bytes(const std::string& path, const std::string& bytes, const std::string& root_folder,
+                     const GltfOptions& options, const GltfTile* tile, const GltfMeshCallback& on_mesh,
+                     std::vector<Problem>& problems, GltfInfo& info);
+
+/// The same model placed once per entry of `tiles` (parsed and decoded once): an i3dm's instances.
+/// Without tiles, as read_gltf_bytes without a tile.
+void read_gltf_instances(const std::string& path, const std::string& bytes, const std::string& root_folder,
+                         const GltfOptions& options, const std::vector<GltfTile>& tiles, const GltfMeshCallback& on_mesh,
+                         std::vector<Problem>& problems, GltfInfo& info);
 
 }  // namespace groundplan::gis

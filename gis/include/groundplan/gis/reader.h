@@ -7,6 +7,8 @@
 //   .kml .kmz              KML + COLLADA  meshes in the working CRS (placed with GeographicLib + PROJ)
 //   .gltf .glb             glTF           meshes in the working CRS (ECEF georeference, else origin)
 //   .dae                   COLLADA alone  meshes in the working CRS; needs ReadOptions::origin
+//   tileset.json .b3dm     3D Tiles       meshes in the working CRS (ECEF after the tile transforms); tiles3d.h
+//   .cmpt (a folder with a tileset.json: that tileset)
 //   .city.json, .json      CityJSON       as CityGML: meshes as written, CRS in info.citygml.srs_name
 //   .city.jsonl, .jsonl    CityJSONSeq    (metadata.referenceSystem); .json only with "type": "CityJSON"
 //   anything else GDAL     OGR layers     meshes as written in the file's one source CRS (info.source_srs,
@@ -19,6 +21,7 @@
 #include <groundplan/gis/gltf.h>
 #include <groundplan/gis/kml.h>
 #include <groundplan/gis/ogr_input.h>
+#include <groundplan/gis/tiles3d.h>
 #include <groundplan/mesh.h>
 #include <groundplan/types.h>
 
@@ -30,7 +33,7 @@
 
 namespace groundplan::gis {
 
-enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb, CityJson, CityJsonSeq, Ogr };
+enum class InputFormat { Unknown, CityGml, Kml, Kmz, Collada, Gltf, Glb, CityJson, CityJsonSeq, Ogr, Tiles3d };
 const char* to_string(InputFormat format);
 
 struct ReadOptions {
@@ -40,6 +43,7 @@ struct ReadOptions {
   std::string origin;           // "lon,lat[,alt]" for glTF without georeference and bare .dae; empty = none
   KmlOptions kml;               // byte limits (KMZ), COLLADA limits
   GltfOptions gltf;
+  Tiles3dOptions tiles3d;       // its gltf member is ReadOptions::gltf (copied in by read_any)
   OgrInputOptions ogr;          // any OGR vector source: layers, filter, ids, grouping (issue 22)
   // CityGML, CityJSON: told the file's bytes as they are read (progress; a .gz's packed bytes, scaled from
   // the unpacked ones read: gzip_progress.h); may be empty
@@ -66,17 +70,19 @@ struct ReadInfo {
   CityJsonInfo cityjson;        // CityJSON / CityJSONSeq only
   KmlInfo kml;                  // KML/KMZ only
   GltfInfo gltf;                // glTF only
+  Tiles3dInfo tiles3d;          // 3D Tiles only
   OgrInfo ogr;                  // OGR sources only
   std::size_t meshes = 0;       // meshes delivered
 };
 
-/// The format of `path`: by extension, else by its first bytes (zip -> Kmz, "glTF" -> Glb, XML root
-/// <kml>/<COLLADA>/CityGML namespace, '{' with "asset" -> Gltf). Unknown when nothing fits.
+/// The format of `path`: by extension, else by its first bytes (zip -> Kmz, "glTF" -> Glb, "b3dm"/"cmpt"
+/// -> Tiles3d, XML root <kml>/<COLLADA>/CityGML namespace, '{' with "asset" and "root" -> Tiles3d, with
+/// "asset" alone -> Gltf; a file named tileset.json -> Tiles3d). Unknown when nothing fits.
 InputFormat detect_format(const std::string& path);
 /// The same from a file name and its first bytes (for a driver's Identify). Does not throw.
 InputFormat detect_format(const std::string& name, std::string_view head);
 /// True for the extensions a folder of tiles is expanded to (.gml .citygml .xml .kml .kmz .gltf .glb
-/// .city.json .city.jsonl; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
+/// .b3dm .i3dm .cmpt .city.json .city.jsonl; a folder holding a tileset.json is that tileset instead; not .dae: a .dae beside a .kml is the KML's model, not a second input; not
 /// plain .json: a tile folder holds other JSON, e.g. 3D Tiles' tileset.json).
 bool is_input_name(const std::string& name);
 /// The names is_input_name takes, for messages: "*.gml, *.citygml, ..., *.city.jsonl.gz".

@@ -1,0 +1,27 @@
+# SPDX-License-Identifier: MIT
+"""3D Tiles through the real CLI and the GDAL driver (the C++ reader tests compare the plans with the source
+CityGML): docs/3d_tiles.md's commands run as written, GROUNDPLAN:tileset.json and a folder open in OGR, the
+feature ids name the buildings."""
+
+from osgeo import gdal
+
+from conftest import BIN, SOURCE_DIR, run
+
+TILES = SOURCE_DIR / "tests" / "data" / "3dtiles"
+
+
+def test_docs_commands_and_driver(tmp_path):
+    out = tmp_path / "plans.gpkg"
+    for args in (["-f", "GPKG", out, TILES / "b3dm" / "tileset.json"],
+                 ["-t_srs", "EPSG:25832", "-f", "GPKG", out, TILES / "b3dm"],
+                 ["--config", "GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "600", "-f", "GPKG", out,
+                  TILES / "levels" / "replace.json"]):
+        out.unlink(missing_ok=True)
+        p = run([BIN, *args])
+        assert "read 80 buildings" in p.stdout + p.stderr, p.stdout + p.stderr
+    for name in ("GROUNDPLAN:" + str(TILES / "glb" / "tileset.json"), "GROUNDPLAN:" + str(TILES / "draco")):
+        ds = gdal.OpenEx(name, gdal.OF_VECTOR)
+        assert ds is not None, name
+        footprints = ds.GetLayerByName("footprints")
+        ids = {f.GetField("source_id") for f in footprints}
+        assert len(ids) == 80 and all(i.startswith("DENILD") for i in ids), sorted(ids)[:5]
