@@ -206,7 +206,31 @@ bool vector_translate(const std::string& dst, GDALDatasetH src, const std::vecto
   return CPLGetLastErrorType() < CE_Failure;
 }
 
-void print_problems(const std::vector<groundplan::Problem>& problems) {
+/// Problems proper, without notes (a CRS guess is worth saying but is no defect).
+std::size_t count_defects(const std::vector<groundplan::Problem>& problems) {
+  std::size_t n = 0;
+  for (const auto& p : problems) n += p.code != "NOTE";
+  return n;
+}
+
+/// "4 problems" or "4 problems, 36 notes": the summary's count, notes apart.
+std::string problems_and_notes(const std::vector<groundplan::Problem>& problems) {
+  const std::size_t defects = count_defects(problems), notes = problems.size() - defects;
+  std::string s = std::to_string(defects) + (defects == 1 ? " problem" : " problems");
+  if (notes) s += ", " + std::to_string(notes) + (notes == 1 ? " note" : " notes");
+  return s;
+}
+
+/// Whether the output holds a problems layer (named among the layers written).
+bool writes_problems(const Ogr2ogrArgs& ogr) {
+  return ogr.layer_named && std::any_of(ogr.layers.begin(), ogr.layers.end(),
+                                        [](const std::string& l) { return EQUAL(l.c_str(), "problems"); });
+}
+
+/// The first problems and notes on stderr, and how many of each are not shown (counted as the summary counts:
+/// problems apart from notes). `problems_written`: the dataset whose problems layer holds them all; empty when no
+/// problems layer was written.
+void print_problems(const std::vector<groundplan::Problem>& problems, const std::string& problems_written = {}) {
   constexpr std::size_t kShown = 20;
   for (std::size_t i = 0; i < problems.size() && i < kShown; ++i) {
     const auto& p = problems[i];
@@ -217,16 +241,16 @@ void print_problems(const std::vector<groundplan::Problem>& problems) {
       std::fprintf(stderr, "groundplan: %s: building %s: %s (%s)\n", p.file.c_str(), p.source_id.c_str(),
                    p.reason.c_str(), p.code.c_str());
   }
-  if (problems.size() > kShown)
-    std::fprintf(stderr, "groundplan: ... and %zu more problems: write the 'problems' layer to see them all\n",
-                 problems.size() - kShown);
-}
-
-/// Problems proper, without notes (a CRS guess is worth saying but is no defect).
-std::size_t count_defects(const std::vector<groundplan::Problem>& problems) {
-  std::size_t n = 0;
-  for (const auto& p : problems) n += p.code != "NOTE";
-  return n;
+  if (problems.size() <= kShown) return;
+  std::size_t notes = 0;
+  for (std::size_t i = kShown; i < problems.size(); ++i) notes += problems[i].code == "NOTE";
+  const std::size_t defects = problems.size() - kShown - notes;
+  std::string more;
+  if (defects) more = std::to_string(defects) + (defects == 1 ? " more problem" : " more problems");
+  if (notes) more += (more.empty() ? "" : " and ") + std::to_string(notes) + (notes == 1 ? " more note" : " more notes");
+  std::fprintf(stderr, "groundplan: ... and %s: %s\n", more.c_str(),
+               problems_written.empty() ? "write the 'problems' layer to see them all"
+                                        : ("all are in the 'problems' layer of " + problems_written).c_str());
 }
 
 std::size_t count_holes(const PipelineResult& r) {
@@ -327,7 +351,8 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                  {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
                  {"ground_plans", result.plans.size()},
-                 {"holes", count_holes(result)},          {"problems", count_defects(result.problems)}};
+                 {"holes", count_holes(result)},          {"problems", count_defects(result.problems)},
+                 {"notes", result.problems.size() - count_defects(result.problems)}};
   j["timings_s"] = {{"read", result.timings.read_s},     {"footprints", result.timings.footprints_s},
                     {"blocks", result.timings.blocks_s}, {"union", result.timings.union_s},
                     {"level_of_detail", result.timings.lod_s}, {"write", write_s},
@@ -497,7 +522,7 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
     members_note = std::to_string(ds->id_lists_cut()) +
                    " plans list more building ids than a DBF field holds (254 characters): their building_ids end "
                    "in '...(+N)'; the full lists are in " +
-                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id)";
+                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id, bldg_id)";
   }
   GDALClose(src_h);
   w.ok = write_ok;
@@ -530,14 +555,30 @@ std::string tiles_ruled_out(const PipelineOptions& options, const Ogr2ogrArgs& o
   return {};
 }
 
-/// A tiled run without a footprint (every building a problem, or none at all): its problems and why nothing is
-/// written, as the one-process run says it.
-void say_nothing_usable(const groundplan::gis::TiledResult& r, const Ogr2ogrArgs& ogr) {
-  if (!ogr.quiet) print_problems(r.problems);
-  std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-               r.buildings_read == 0
-                   ? "no building found"
-                   : (std::to_string(r.buildings_read) + " buildings read, none gave a footprint").c_str());
+/// Nothing usable (every building a problem, or no building at all): the problems layer alone is written where it
+/// was asked for (through `ds`, taken and closed here; null: nothing is written, as a rank of a run over ranks does),
+/// no empty ground plans that would look like a result; the problems and why nothing else is written go to stderr.
+/// The run fails all the same.
+void say_nothing_usable(const std::vector<groundplan::Problem>& problems, std::size_t buildings_read,
+                        const Ogr2ogrArgs& ogr, GDALDataset* ds) {
+  bool wrote = false;
+  if (ds) {
+    GDALDatasetH h = GDALDataset::ToHandle(ds);
+    if (writes_problems(ogr)) {
+      std::vector<std::string> args = option_flags(ogr);
+      args.push_back("problems");
+      int usage_error = FALSE;
+      wrote = vector_translate(ogr.dst, h, args, false, &usage_error);
+      if (!wrote) std::fprintf(stderr, "groundplan: could not write the problems layer to %s\n", ogr.dst.c_str());
+    }
+    GDALClose(h);
+  }
+  if (!ogr.quiet) print_problems(problems, wrote ? ogr.dst : std::string());
+  const std::string why = buildings_read == 0
+                              ? "no building found"
+                              : std::to_string(buildings_read) + " buildings read, none gave a footprint";
+  std::fprintf(stderr, "groundplan: %s: nothing usable: %s; %s\n", ogr.src.c_str(), why.c_str(),
+               wrote ? ("only the 'problems' layer written, to " + ogr.dst).c_str() : "nothing written");
 }
 
 /// ogr2ogr's options without the layer names (they come last), and the layers written (ground_plans unless named).
@@ -550,7 +591,8 @@ bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::Til
   const groundplan::gis::TileStats& t = r.tiles;
   nlohmann::json j;
   j["counts"] = {{"buildings", r.buildings_read}, {"footprints", r.footprints}, {"dropped", r.buildings_dropped},
-                 {"blocks", r.blocks}, {"ground_plans", plans}, {"problems", count_defects(r.problems)}};
+                 {"blocks", r.blocks}, {"ground_plans", plans}, {"problems", count_defects(r.problems)},
+                 {"notes", r.problems.size() - count_defects(r.problems)}};
   j["timings_s"] = {{"read", r.timings.read_s}, {"footprints", r.timings.footprints_s}, {"blocks", r.timings.blocks_s},
                     {"union", r.timings.union_s}, {"write", write_s}, {"spatial_index", index_s},
                     {"total", total_s}, {"cpu", cpu_s}};
@@ -591,12 +633,12 @@ void print_tiled_summary(const groundplan::gis::TiledResult& r, const Ogr2ogrArg
               r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles,
               r.ranks.size() > 1 ? (" on " + std::to_string(r.ranks.size()) + " MPI ranks").c_str() : "");
   std::printf("groundplan: %zu footprints -> %zu ground plans (%zu final at once, %zu from %zu seam plans of "
-              "%zu footprints); %zu problems\n",
+              "%zu footprints); %s\n",
               r.footprints, plans, t.final_plans, t.reduced_plans, t.seam_plans, t.seam_footprints,
-              count_defects(r.problems));
+              problems_and_notes(r.problems).c_str());
   std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", dst.c_str(), total_s,
               t.map_s, t.reduce_s, write_s);
-  print_problems(r.problems);
+  print_problems(r.problems, writes_problems(ogr) ? dst : std::string());
 }
 
 #ifdef GROUNDPLAN_WITH_MPI
@@ -638,7 +680,7 @@ int run_tiled_into_database(const PipelineOptions& options, const Ogr2ogrArgs& o
   const std::string nln = groundplan::cli::table_name(option_flags(ogr), "");
   for (const std::string& l : layers) setup.tables.push_back(layers.size() == 1 && !nln.empty() ? nln : l);
   if (root && r.footprints == 0) {
-    say_nothing_usable(r, ogr);
+    say_nothing_usable(r.problems, r.buildings_read, ogr, nullptr);
     setup.create = false;
   }
   auto* mine = new groundplan::driver::OGRGroundPlanDataSource(std::string(groundplan::driver::kPrefix) + ogr.src,
@@ -746,7 +788,7 @@ int run_tiled_gpkg_by_ranks(const PipelineOptions& options, const Ogr2ogrArgs& o
     const std::filesystem::path dst(w.dst);
     w.folder = dst.has_parent_path() ? dst.parent_path().string() : ".";
     if (r.footprints == 0) {
-      say_nothing_usable(r, ogr);
+      say_nothing_usable(r.problems, r.buildings_read, ogr, nullptr);
       w.nothing = true;
     }
   }
@@ -847,13 +889,17 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
     return write_tiled_stats(stats_path, r, r.plan_count(), write_s, index_s, written, seconds_since(t0),
                              groundplan::gis::process_cpu_seconds() - cpu0);
   };
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
+  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
   if (r.footprints == 0) {
-    say_nothing_usable(r, ogr);
+    // Over ranks the output is staged and not committed on failure: nothing is written there.
+    say_nothing_usable(r.problems, r.buildings_read, ogr,
+                       rank_count(ranks) > 1 ? nullptr
+                                             : new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars,
+                                                                                               options.threads));
     stats(0, 0, nullptr);
     return finish(1);
   }
-  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
-  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, options.threads);
   // Plans are read back from the run's spill by position: datasets side by side may read it at once.
   WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
@@ -1055,12 +1101,10 @@ int run(int argc, char** argv, Ranks* ranks) {
 
   // Nothing usable (every building a problem, or no building at all): say so and fail, without
   // writing an empty result that would look like success (issue 8). The problems say why.
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
   if (result.footprints.empty()) {
-    if (!ogr.quiet) print_problems(result.problems);
-    std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-                 result.buildings_read == 0
-                     ? "no building found"
-                     : (std::to_string(result.buildings_read) + " buildings read, none gave a footprint").c_str());
+    say_nothing_usable(result.problems, result.buildings_read, ogr,
+                       new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, options.threads));
     if (!stats_path.empty())
       write_stats(stats_path, result, 0, 0, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0, nullptr,
                   options.detail);
@@ -1068,7 +1112,6 @@ int run(int argc, char** argv, Ranks* ranks) {
   }
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
-  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, options.threads);
   const WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
     return new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, threads);
@@ -1088,8 +1131,8 @@ int run(int argc, char** argv, Ranks* ranks) {
   if (!ogr.quiet) {
     std::printf("groundplan: read %zu buildings from %s (CRS %s)\n", result.buildings_read, ogr.src.c_str(),
                 result.crs_name.empty() ? "unknown" : result.crs_name.c_str());
-    std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %zu problems\n",
-                result.footprints.size(), result.plans.size(), holes, count_defects(result.problems));
+    std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %s\n", result.footprints.size(),
+                result.plans.size(), holes, problems_and_notes(result.problems).c_str());
     std::printf(
         "groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, blocks %.2f s (%zu, %s), union %.2f s, "
         "write %.2f s)\n",
@@ -1099,7 +1142,7 @@ int run(int argc, char** argv, Ranks* ranks) {
     if (options.detail.any())
       std::printf("groundplan: level of detail (%.2f s): %s\n", result.timings.lod_s,
                   lod_summary(options.detail, result.lod_stats).c_str());
-    print_problems(result.problems);
+    print_problems(result.problems, writes_problems(ogr) ? ogr.dst : std::string());
   }
 
   if (!preview_path.empty()) groundplan::cli::write_preview_png(result, preview_path);

@@ -42,10 +42,12 @@ class SpilledResult final : public TiledResult {
     if (!segments.empty())
       for (std::uint32_t& m : out.plan.members) m += segment(i).id_shift;
     out.member_ids.reserve(s.footprints.size());
+    out.member_buildings.reserve(s.footprints.size());
     for (std::size_t k = 0; k < s.footprints.size(); ++k) {
       const Footprint& fp = s.footprints[k];
       out.min_z = k ? std::min(out.min_z, fp.min_z) : fp.min_z;
       out.max_z = k ? std::max(out.max_z, fp.max_z) : fp.max_z;
+      out.member_buildings.push_back(building_id_of(fp));
       out.member_ids.push_back(fp.source_id);
     }
     return out;
