@@ -159,3 +159,20 @@ def test_niedersachsen_parts_name_their_buildings(tmp_path):
     plans = {f["gp_id"]: f["buildings"] for f in ds.GetLayerByName("ground_plans")}
     for r in parts:
         assert r["building_id"] in plans[r["gp_id"]].split(",")
+
+
+def test_ogr_group_by_names_the_group_as_the_building(tmp_path):
+    # Three 2D parts of two buildings (field "bid"): --group-by makes each group one member, named by the group.
+    def square(x, y, s):
+        return [[[x, y], [x + s, y], [x + s, y + s], [x, y + s], [x, y]]]
+    feats = [("p1", "B1", square(500000, 5700000, 10)), ("p2", "B1", square(500010, 5700000, 10)),
+             ("p3", "B2", square(500015, 5700005, 10))]
+    src = tmp_path / "parts.geojson"
+    src.write_text(json.dumps({"type": "FeatureCollection",
+                               "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::25832"}},
+                               "features": [{"type": "Feature", "properties": {"pid": p, "bid": b},
+                                             "geometry": {"type": "Polygon", "coordinates": g}} for p, b, g in feats]}))
+    out = tmp_path / "g.gpkg"
+    run([BIN, "--group-by", "bid", "-f", "GPKG", out, src, "ground_plans", "plan_members"])
+    assert sorted((r["source_id"], r["building_id"]) for r in items(out, "plan_members")) == [("B1", "B1"), ("B2", "B2")]
+    assert [r["buildings"] for r in items(out, "ground_plans")] == ["B1,B2"]
