@@ -1058,6 +1058,9 @@ int run(int argc, char** argv, Ranks* ranks) {
     options.threads = groundplan::gis::threads_from_string(v, "GDAL_NUM_THREADS");
   options.read_chunk_bytes = read_chunk_bytes;
   options.read_range_features = read_range_features;
+  // The problems layer asked for is written even when no input could be read (over ranks the first fault stops
+  // every rank, as before).
+  options.unreadable_throws = !writes_problems(ogr) || rank_count(ranks) > 1;
 
   // Tiles (issue 15): a large folder of tiles is mapped tile by tile with bounded memory (same plans).
   const std::string tiles_mode = lower(tiles);

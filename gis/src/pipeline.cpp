@@ -376,7 +376,8 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   std::sort(result.files_read.begin(), result.files_read.end());
   result.files_read.erase(std::unique(result.files_read.begin(), result.files_read.end()), result.files_read.end());
   xml::release_cached_blocks();  // the reading threads' spare memory, before the union needs its own
-  if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
+  if (files_failed == files.size() && result.footprints.empty() && options.unreadable_throws)
+    throw InputError(first_failure);
   result.timings.read_s = std::max(0.0, seconds_since(t_read) - result.timings.footprints_s);
 
   const auto t_union = clock_type::now();

@@ -142,6 +142,24 @@ def test_problems_layer_is_written_when_nothing_is_usable(tmp_path, tiles):
     assert "nothing written" in p.stderr and "write the 'problems' layer to see them all" in p.stderr
 
 
+@pytest.mark.parametrize("tiles", ["off", "on"])
+def test_problems_layer_is_written_when_no_input_can_be_read(tmp_path, tiles):
+    """Every input unreadable: the problems layer asked for names each file and its fault; the run fails."""
+    folder = tmp_path / "bad"
+    folder.mkdir()
+    (folder / "a_empty.gml").write_text("")
+    (folder / "b_garbage.gml").write_bytes(bytes(range(256)) * 4)
+    out = tmp_path / "out.gpkg"
+    p = run([BIN, "--tiles", tiles, "-f", "GPKG", out, folder, "ground_plans", "problems"], check=False)
+    assert p.returncode == 1, p.stderr
+    assert "only the 'problems' layer written" in p.stderr, p.stderr
+    ds = ogr.Open(str(out))
+    assert [ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())] == ["problems"]
+    unreadable = {pathlib.Path(f["file"]).name: f["reason"] for f in ds.GetLayer(0) if f["code"] == "UNREADABLE_FILE"}
+    assert set(unreadable) == {"a_empty.gml", "b_garbage.gml"}
+    assert "empty" in unreadable["a_empty.gml"]
+
+
 def test_whole_corpus_folder_as_one_input(tmp_path):
     """A folder of tiles where many are bad: the good buildings still come out, nothing is lost."""
     out, stats = tmp_path / "out.gpkg", tmp_path / "stats.json"

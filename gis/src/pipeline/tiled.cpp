@@ -592,7 +592,7 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     ts.map_s = share.map_s;
     ts.reduce_s = share.reduce_s;
   }
-  if (failed_total == files.size() && footprints_total == 0)
+  if (failed_total == files.size() && footprints_total == 0 && options.unreadable_throws)
     throw InputError(first_failure.empty() ? "no input file could be read" : first_failure);
 
   out->problems = std::move(acc.problems);

@@ -48,6 +48,9 @@ struct PipelineOptions {
   /// meanwhile). Not called with a level of detail, whose steps change the union's plans. Empty, or null returned:
   /// none.
   std::function<PlanFeed*(const PipelineResult& read)> plan_feed;
+  /// No input could be read at all: true throws InputError (the first file's fault); false returns the result,
+  /// without footprints, its problems naming every file's fault (the CLI, to write the problems layer asked for).
+  bool unreadable_throws = true;
 };
 
 /// How the inputs were read (--stats "reading").
@@ -96,7 +99,8 @@ struct PipelineResult {
 };
 
 /// Runs read -> footprints -> union. Throws InputError when no input can be read at all (every file
-/// unreadable and no footprint from any: a truncated file still gives the buildings before the cut), Cancelled
+/// unreadable and no footprint from any: a truncated file still gives the buildings before the cut; unless
+/// options.unreadable_throws is false), Cancelled
 /// when `progress` asks to stop. A bad building is a Problem, not an exception.
 PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
 
