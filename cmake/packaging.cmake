@@ -12,9 +12,7 @@ add_library(libgroundplan SHARED ${CMAKE_SOURCE_DIR}/packaging/libgroundplan.cpp
 target_link_libraries(libgroundplan PRIVATE groundplan_flags PkgConfig::MPFR TBB::tbb PROJ::proj EXPAT::EXPAT
                                             GEOS::geos_c GDAL::GDAL groundplan_geographiclib PkgConfig::GMPXX simdjson::simdjson
                                             pugixml::static)
-if(TARGET CUDA::cudart)
-  target_link_libraries(libgroundplan PRIVATE CUDA::cudart)
-endif()
+target_link_libraries(libgroundplan PRIVATE ${CMAKE_DL_LIBS})   # the CUDA module is loaded, not linked (gpu/)
 target_include_directories(libgroundplan INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
 set_target_properties(libgroundplan PROPERTIES OUTPUT_NAME groundplan VERSION ${PROJECT_VERSION}
                                                SOVERSION ${PROJECT_VERSION_MAJOR}
@@ -32,17 +30,21 @@ set(GROUNDPLAN_GDAL_PLUGIN_INSTALL_DIR "${default_plugin_dir}" CACHE STRING
 
 install(TARGETS groundplan RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 install(TARGETS ogr_GroundPlan LIBRARY DESTINATION ${GROUNDPLAN_GDAL_PLUGIN_INSTALL_DIR} COMPONENT runtime)
+# The CUDA raster backend's module, beside libgroundplan in the library folder where dlopen finds it by name.
+if(TARGET groundplan_cuda)
+  install(TARGETS groundplan_cuda LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_SKIP)
+endif()
 install(TARGETS libgroundplan EXPORT groundplanTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT runtime)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/core/include/groundplan ${CMAKE_SOURCE_DIR}/gis/include/groundplan
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT runtime FILES_MATCHING PATTERN "*.h")
-# The QGIS plugin (issue 18, qgis/groundplan_provider): Debian's QGIS looks for Python plugins in its own
-# pkgDataPath()/python/plugins, /usr/share/qgis/python/plugins (beside its processing and db_manager), and in
-# the user's profile; the first is the one a package may write. QGIS lists it under Plugins > Manage and
-# Install Plugins; enabling it there (or `qgis_process plugins enable groundplan_provider`) adds the
-# algorithm to the Processing toolbox.
-set(GROUNDPLAN_QGIS_PLUGIN_INSTALL_DIR "share/qgis/python/plugins" CACHE STRING
-    "Where the QGIS Processing plugin is installed, relative to CMAKE_INSTALL_PREFIX (QGIS's plugin folder)")
+# The QGIS plugin (qgis/groundplan_provider): QGIS looks for Python plugins in its own
+# pkgDataPath()/python/plugins, compiled into it (Debian: /usr/share/qgis/python/plugins, beside its processing
+# and db_manager), in the user's profile and in QGIS_PLUGINPATH; the first is the one an install may write,
+# whatever our prefix (as for GDAL's plugin folder above). QGIS lists it under Plugins > Manage and Install
+# Plugins; enabling it there adds the algorithm to the Processing toolbox.
+set(GROUNDPLAN_QGIS_PLUGIN_INSTALL_DIR "/usr/share/qgis/python/plugins" CACHE STRING
+    "Where the QGIS Processing plugin is installed (QGIS's plugin folder; relative paths are under CMAKE_INSTALL_PREFIX)")
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/qgis/groundplan_provider DESTINATION ${GROUNDPLAN_QGIS_PLUGIN_INSTALL_DIR}
         COMPONENT runtime FILES_MATCHING PATTERN "*.py" PATTERN "metadata.txt" PATTERN "__pycache__" EXCLUDE)
 install(FILES ${CMAKE_SOURCE_DIR}/packaging/groundplan.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime)
@@ -67,8 +69,13 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Ground plans (exact union of building foo
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)   # dependencies from the linked libraries (libgdal32, libgeos-c1v5 ...)
+set(CPACK_DEBIAN_PACKAGE_GENERATE_SHLIBS ON)   # shlibs for libgroundplan.so.0, and the ldconfig trigger
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "gdal-bin")
-set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+# The Python module (built for the build machine's python3) converts to Shapely and GeoPandas when asked; the CLI
+# and the GDAL plugin need neither. The QGIS plugin needs QGIS.
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3, python3-shapely")
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-geopandas, qgis, openmpi-bin")
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)   # Debian's; packaging/build-deb.sh also configures with it
 set(CPACK_COMPONENTS_ALL runtime)
 set(CPACK_DEB_COMPONENT_INSTALL OFF)
 include(CPack)

@@ -10,6 +10,15 @@
 
 namespace groundplan::gis::detail {
 
+bool narrower_than(GEOSContextHandle_t h, const GEOSGeometry* piece, double w) {
+  double area = 0, perimeter = 0;
+  GEOSArea_r(h, piece, &area);
+  GEOSLength_r(h, piece, &perimeter);
+  if (perimeter > 0 && 2 * area / perimeter <= w / 2) return true;
+  const GeomPtr left(GEOSBuffer_r(h, piece, -w / 2, 8), GeomDeleter{h});
+  return left && GEOSisEmpty_r(h, left.get()) == 1;
+}
+
 BelowPitch differences_below_pitch(const std::vector<Polygon>& ours, const std::vector<Polygon>& geos, double pitch) {
   // A local origin: coordinates of 1e6 m have ulps of 1e-10 m, too coarse for a buffer of 1e-8 m. The shift is
   // an integer no larger than the coordinates, so it is exact for coordinates of the same sign and binade.
@@ -59,12 +68,7 @@ BelowPitch differences_below_pitch(const std::vector<Polygon>& ours, const std::
   collect_polygons(h, d.get(), pieces);
   const GEOSGeometry* wide = nullptr;
   for (const GEOSGeometry* piece : pieces) {
-    double area = 0, perimeter = 0;
-    GEOSArea_r(h, piece, &area);
-    GEOSLength_r(h, piece, &perimeter);
-    if (perimeter > 0 && 2 * area / perimeter <= w / 2) continue;
-    const GeomPtr left(GEOSBuffer_r(h, piece, -w / 2, 8), GeomDeleter{h});
-    if (left && GEOSisEmpty_r(h, left.get()) == 1) continue;
+    if (narrower_than(h, piece, w)) continue;
     wide = piece;
     break;
   }

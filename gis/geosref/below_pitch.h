@@ -6,6 +6,8 @@
 // where the polygon or hole counts or the areas differ, so by `groundplan --verify` and by the tests.
 #include <groundplan/types.h>
 
+#include <geos_c.h>
+
 #include <string>
 #include <vector>
 
@@ -24,6 +26,11 @@ struct BelowPitch {
 /// differ only where a gap (joined), a neck (split) or a hole (collapsed, closed off by a gap, or let out
 /// through a neck) narrower than w made it differ; the area by up to w times the length of such features.
 /// Computed about a local origin, so that widths of 1e-8 m at coordinates of 1e6 m are resolved.
+/// One piece of a symmetric difference (its coordinates about a local origin, see below) is narrower than w:
+/// shrinking it by w/2 leaves nothing, or twice its area over its perimeter (its width, for a sliver) is at
+/// most w/2.
+bool narrower_than(GEOSContextHandle_t h, const GEOSGeometry* piece, double w);
+
 BelowPitch differences_below_pitch(const std::vector<Polygon>& ours, const std::vector<Polygon>& geos, double pitch);
 
 }  // namespace groundplan::gis::detail

@@ -293,9 +293,7 @@ class CudaRasterBackend final : public RasterBackend {
   std::uint64_t band_keys_;
 };
 
-}  // namespace
-
-int cuda_device_count() {
+int device_count() {
   int count = 0;
   if (cudaGetDeviceCount(&count) != cudaSuccess) {
     cudaGetLastError();  // clear it: no device or no driver is an answer, not an error
@@ -304,12 +302,34 @@ int cuda_device_count() {
   return count;
 }
 
-std::unique_ptr<RasterBackend> make_cuda_raster_backend(std::uint64_t band_keys) {
-  if (cuda_device_count() <= 0)
-    throw GpuError(
-        "no CUDA device answers (cudaGetDeviceCount found none, or no usable NVIDIA driver); use --device cpu or "
-        "--device auto");
-  return std::make_unique<CudaRasterBackend>(band_keys);
+RasterBackend* make_backend(std::uint64_t band_keys, char* error, std::size_t error_size) {
+  int count = 0;
+  const cudaError_t e = cudaGetDeviceCount(&count);
+  if (e != cudaSuccess || count <= 0) {
+    // without libcuda (no NVIDIA driver) the static runtime says "driver version is insufficient": say both
+    const std::string why =
+        e == cudaErrorInsufficientDriver
+            ? std::string("no CUDA device answers: no NVIDIA driver, or one older than this CUDA runtime (cudaGetDeviceCount: ") +
+                  cudaGetErrorString(e) + ")"
+            : std::string("no CUDA device answers (cudaGetDeviceCount: ") +
+                  (e != cudaSuccess ? cudaGetErrorString(e) : "no device") + ")";
+    cudaGetLastError();
+    if (error_size) {
+      const std::size_t n = std::min(why.size(), error_size - 1);
+      why.copy(error, n);
+      error[n] = '\0';
+    }
+    return nullptr;
+  }
+  return new CudaRasterBackend(band_keys);
 }
 
+constexpr CudaModuleApi kApi{GROUNDPLAN_CUDA_MODULE_BUILD, &device_count, &make_backend};
+
+}  // namespace
 }  // namespace groundplan::detail
+
+// The module's one exported symbol (every other one is hidden: gpu/CMakeLists.txt).
+extern "C" __attribute__((visibility("default"))) const groundplan::detail::CudaModuleApi* groundplan_cuda_module_api() {
+  return &groundplan::detail::kApi;
+}

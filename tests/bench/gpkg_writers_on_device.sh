@@ -1,5 +1,5 @@
 #!/bin/bash
-# The GeoPackage written by several writers (driver/cli/gpkg_slices.h, issue 14) against one writer, on the
+# The GeoPackage written by several writers (driver/output/gpkg_slices.h, issue 14) against one writer, on the
 # 16-core GPU host (no GDAL there: the CLI comes packed by tests/gpu/pack_cli.sh). A generated LoD1 city
 # (gen_big_citygml.py) as one file and as 16 tiles (--tiles off: one process), all cores, alternated rounds:
 #   slices  the default (one writer per 8,192 plans, at most 16);

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
-// What each level-of-detail setting removes on the real samples (issue 9): plans, holes, holes under
-// 1e-3 m2, neighbours closer than 1 mm, relative area change against the exact union, vertices,
-// validity and overlaps (GEOS), what a GEOS closing of width D would still add, and the time. Prints a
-// Markdown table per sample; docs/level_of_detail.md holds its output.
-//   lod_report [sample ...]   (paths to files or folders; default: every real sample)
+// What each level-of-detail setting removes on the real samples: plans, holes, holes under 1e-3 m2,
+// neighbours closer than 1 mm, relative area change against the exact union, vertices, validity and
+// overlaps (GEOS), what a GEOS closing of width D would still add, and the time. Prints a Markdown table
+// per sample: docs/level_of_detail.md holds its output on the bundled samples without the times (regenerated
+// and compared by the docs_examples test), tests/bench/RESULTS.md the full output.
+//   lod_report [--no-times] [sample ...]   (paths to files or folders; default: every real sample)
 #include <groundplan/gis/pipeline.h>
 #include <groundplan/level_of_detail.h>
 
@@ -45,7 +46,13 @@ std::vector<Setting> settings() {
 
 int main(int argc, char** argv) {
   std::vector<std::string> samples;
-  for (int i = 1; i < argc; ++i) samples.push_back(argv[i]);
+  bool times = true;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--no-times")
+      times = false;
+    else
+      samples.push_back(argv[i]);
+  }
   if (samples.empty())
     samples = {test::sample_data("plateau-niiza/53395404_bldg_6697_op.gml"),
                test::sample_data("niedersachsen-lorup/LoD1_24065862_2_2021-01-25.gml"),
@@ -63,8 +70,8 @@ int main(int argc, char** argv) {
     std::printf("\n### %s\n\n%zu buildings, %zu footprints, exact union %.3f m2\n\n", path.c_str(), r.buildings_read,
                 r.footprints.size(), base.area_m2);
     std::printf("| setting | plans | holes | holes < 1e-3 m2 | pairs < 1 mm apart | area change (rel.) | vertices | "
-                "invalid / overlapping | GEOS closing still adds (m2) | time (s) |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+                "invalid / overlapping | GEOS closing still adds (m2) |%s\n", times ? " time (s) |" : "");
+    std::printf("|---|---|---|---|---|---|---|---|---|%s\n", times ? "---|" : "");
     for (const Setting& s : settings()) {
       std::vector<Problem> problems;
       UnionParams up;
@@ -75,9 +82,11 @@ int main(int argc, char** argv) {
       const testing::LodMetrics m = testing::measure_plans(plans, 1e-3, 1e-3, s.gap_check);
       char residual[32] = "";
       if (s.gap_check > 0) std::snprintf(residual, sizeof residual, "%.3g (D=%.3g)", m.closing_residual_m2, s.gap_check);
-      std::printf("| `%s` | %zu | %zu | %zu | %zu | %+.2e | %zu | %zu / %zu | %s | %.3f |\n", s.name.c_str(), m.plans,
-                  m.holes, m.small_holes, m.close_pairs, (m.area_m2 - base.area_m2) / base.area_m2, m.vertices,
-                  m.invalid, m.overlapping_pairs, residual, secs);
+      std::printf("| `%s` | %zu | %zu | %zu | %zu | %+.2e | %zu | %zu / %zu | %s |", s.name.c_str(), m.plans, m.holes,
+                  m.small_holes, m.close_pairs, (m.area_m2 - base.area_m2) / base.area_m2, m.vertices, m.invalid,
+                  m.overlapping_pairs, residual);
+      if (times) std::printf(" %.3f |", secs);
+      std::printf("\n");
     }
   }
   return 0;

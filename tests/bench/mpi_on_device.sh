@@ -3,7 +3,7 @@
 # Issue 15 on the 16-core host (no GDAL, no MPI there): `mpirun -np N groundplan -f GPKG` for N = 1, 2, 4, 8, 16 on a
 # generated tiled city (gen_tiled_city.py; default 8 x 8 tiles of 8 x 8 copies of the Lorup tile, about 3.3 GB),
 # one thread a rank. Over ranks every rank writes its own plans into a GeoPackage slice and rank 0 appends the
-# slices (driver/cli/gpkg_rank_slices.h; --stats "writer" says so). Prints a line a run: wall, rank 0's map, the
+# slices (driver/output/gpkg_rank_slices.h; --stats "writer" says so). Prints a line a run: wall, rank 0's map, the
 # reduce step (the slowest rank's reduce + gather) and its share, the write (rank 0's: its slice, the append, the
 # index), speed-up and efficiency against N = 1, peak RSS of the largest rank; then the writer entry and per rank:
 # tiles, bytes, map, reduce, gather, peak RSS; and whether every N gave the plans of N = 1 (sorted vertex cycles

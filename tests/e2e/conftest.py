@@ -13,14 +13,63 @@ gdal.UseExceptions()
 SOURCE_DIR = pathlib.Path(os.environ.get("GROUNDPLAN_SOURCE_DIR", pathlib.Path(__file__).parents[2]))
 BIN = os.environ.get("GROUNDPLAN_BIN", str(SOURCE_DIR / "build" / "bin" / "groundplan"))
 PLUGIN_DIR = os.environ.get("GDAL_DRIVER_PATH", str(SOURCE_DIR / "build" / "gdalplugins"))
-SHARED_DATA = pathlib.Path(os.environ.get("GROUNDPLAN_SHARED_DATA_DIR", SOURCE_DIR.parent / "shared" / "data"))
 SAMPLES = SOURCE_DIR / "sample_data"
+# Real third-party city models, one folder per dataset named as in ../shared/data (tests/data/README.md):
+# SHARED_DATA holds those that may be redistributed (in the repository, each folder with its SOURCE.txt);
+# THIRDPARTY_DATA the others, outside the repository: GROUNDPLAN_SHARED_DATA_DIR, else ../shared/data beside the
+# source tree (or the folder cmake was given, GROUNDPLAN_SHARED_DATA_CONFIGURED under ctest). Tests that need them
+# are marked thirdparty_data (ctest label thirdparty-data) and skip without them.
+SHARED_DATA = SOURCE_DIR / "tests" / "data"
+THIRDPARTY_DATA = pathlib.Path(os.environ.get("GROUNDPLAN_SHARED_DATA_DIR")
+                               or os.environ.get("GROUNDPLAN_SHARED_DATA_CONFIGURED")
+                               or SOURCE_DIR.parent / "shared" / "data")
+THIRDPARTY_MISSING = (f"needs the third-party samples folder {THIRDPARTY_DATA} (not redistributable, not in the "
+                      "repository; set GROUNDPLAN_SHARED_DATA_DIR to a copy of the samples)")
+thirdparty_data = pytest.mark.thirdparty_data
 
 PLATEAU = SAMPLES / "plateau-niiza" / "53395404_bldg_6697_op.gml"
 PLATEAU_SMALL = SAMPLES / "plateau-niiza" / "53392547_bldg_6697_op2.gml"
 LORUP = SAMPLES / "niedersachsen-lorup" / "LoD1_24065862_2_2021-01-25.gml"
 TUM = SAMPLES / "tum-main-entrance" / "TUM-Main-Entrance.gml"
-BERLIN = SHARED_DATA / "citygml1-berlin-lod2-libcitygml" / "berlin_open_data_sample_data.citygml"
+BERLIN = THIRDPARTY_DATA / "citygml1-berlin-lod2-libcitygml" / "berlin_open_data_sample_data.citygml"
+
+
+def real_sample_files(suffixes, thirdparty=False):
+    """Every file with one of `suffixes` of the real samples in the repository (sample_data/, tests/data/), or of
+    the third-party folder less what tests/data/ holds too; each file once (links followed), sorted."""
+    if thirdparty:
+        roots = [THIRDPARTY_DATA] if THIRDPARTY_DATA.is_dir() else []
+    else:
+        roots = [SAMPLES, SHARED_DATA]
+    seen, out = set(), []
+    for root in roots:
+        for p in sorted(root.rglob("*")):
+            if p.suffix.lower() not in suffixes or not p.is_file():
+                continue
+            if thirdparty and (SHARED_DATA / p.relative_to(root)).exists():
+                continue
+            if p.resolve() not in seen:
+                seen.add(p.resolve())
+                out.append(p)
+    return sorted(out)
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "thirdparty_data: needs real samples that may not be redistributed "
+                                       "(THIRDPARTY_DATA); skipped where they are absent")
+
+
+def pytest_sessionstart(session):
+    """The ctest of the thirdparty-data label (-m thirdparty_data) where the folder is absent: one line, and the exit
+    code ctest counts as a skip (SKIP_RETURN_CODE 77), not a pass."""
+    if session.config.getoption("markexpr") == "thirdparty_data" and not THIRDPARTY_DATA.is_dir():
+        print(f"SKIPPED: {THIRDPARTY_MISSING}", flush=True)
+        os._exit(77)  # before anything is set up; pytest.exit would say it twice
+
+
+def pytest_runtest_setup(item):
+    if item.get_closest_marker("thirdparty_data") is not None and not THIRDPARTY_DATA.is_dir():
+        pytest.skip(THIRDPARTY_MISSING)
 
 
 def gdal_env():

@@ -172,18 +172,21 @@ def test_whole_corpus_folder_as_one_input(tmp_path):
 
 
 def _real_inputs():
-    """Every real sample: sample_data/*/*.gml, every CityGML file of the shared data, and each shared
-    data folder of CityGML as one input (a folder of tiles)."""
-    from conftest import SAMPLES, SHARED_DATA
-    files = sorted(SAMPLES.glob("*/*.gml"))
-    folders = []
-    if SHARED_DATA.is_dir():
-        for d in sorted(p for p in SHARED_DATA.iterdir() if p.is_dir()):
-            gml = sorted(p for p in d.iterdir() if p.suffix.lower() in (".gml", ".citygml", ".xml"))
-            files += gml
-            if len(gml) > 1:
-                folders.append(d)
-    return files + folders
+    """Every real sample: every CityGML file of sample_data/ and tests/data/, and each dataset folder of CityGML
+    as one input (a folder of tiles); the same of the third-party samples, marked thirdparty_data."""
+    from conftest import SHARED_DATA, THIRDPARTY_DATA, real_sample_files, thirdparty_data
+    suffixes = (".gml", ".citygml", ".xml")
+
+    def citygml(d):
+        return [p for p in d.iterdir() if p.suffix.lower() in suffixes] if d.is_dir() else []
+
+    def folders(root):
+        return [d for d in sorted(p for p in root.iterdir() if p.is_dir()) if len(citygml(d)) > 1] if root.is_dir() else []
+    # a third-party folder as one input where the repository holds only part of it
+    thirdparty = real_sample_files(suffixes, True) + [d for d in folders(THIRDPARTY_DATA)
+                                                       if len(citygml(d)) > len(citygml(SHARED_DATA / d.name))]
+    return real_sample_files(suffixes) + folders(SHARED_DATA) + [pytest.param(p, marks=thirdparty_data)
+                                                                  for p in thirdparty]
 
 
 @pytest.mark.parametrize("src", _real_inputs(), ids=lambda p: f"{p.parent.name}/{p.name}")

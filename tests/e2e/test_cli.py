@@ -98,6 +98,20 @@ def test_bad_flag_value_fails():
     assert "quantum" in p.stderr
 
 
+def test_device_cuda_runs_or_says_what_is_missing(tmp_path):
+    """--device cuda: the plans from the GPU where the CUDA module loads and a device answers; elsewhere exit status 1
+    with a line saying which is missing (the module, or a driver/device), never a crash and never a quiet CPU run."""
+    stats = tmp_path / "s.json"
+    p = run([BIN, "--device", "cuda", "--stats", stats, "-f", "GPKG", tmp_path / "c.gpkg", TUM], check=False)
+    if p.returncode == 0:
+        assert json.loads(stats.read_text())["raster_backend"] == "cuda"
+        return
+    assert p.returncode == 1, p.stderr
+    assert ("libgroundplan_cuda.so.0 could not be loaded" in p.stderr or "no CUDA device answers" in p.stderr), p.stderr
+    assert "use --device cpu" in p.stderr
+    assert not stats.exists()
+
+
 def test_garbage_input_fails_with_the_name(tmp_path):
     bad = tmp_path / "garbage.gml"
     bad.write_bytes(b"\x00\x01 this is not XML <<<")

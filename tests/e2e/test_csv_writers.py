@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""A new CSV file of the plans written by several writers side by side (issue 14, driver/cli/csv_slices.h) is,
+"""A new CSV file of the plans written by several writers side by side (issue 14, driver/output/csv_slices.h) is,
 byte for byte, the file one writer makes; options the slices cannot keep (a second layer, -lco CREATE_CSVT,
 HEADERS, WRITE_BOM, ogr2ogr options across features, an existing file) keep one writer, and --stats says which
 was used and why. No slice file is left beside it."""

@@ -4,14 +4,14 @@ random reads, filters, extents and capabilities behave as OGR users expect."""
 import pytest
 from osgeo import gdal, ogr
 
-from conftest import BERLIN
+from conftest import LORUP
 
 gdal.UseExceptions()
 
 
 @pytest.fixture(scope="module")
 def ds():
-    d = gdal.OpenEx(f"GROUNDPLAN:{BERLIN}", gdal.OF_VECTOR)
+    d = gdal.OpenEx(f"GROUNDPLAN:{LORUP}", gdal.OF_VECTOR)
     assert d.GetDriver().ShortName == "GroundPlan"
     return d
 
@@ -20,7 +20,7 @@ def test_layers_and_crs(ds):
     names = [ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())]
     assert names == ["ground_plans", "footprints", "problems", "plan_members"]
     srs = ds.GetLayerByName("ground_plans").GetSpatialRef()
-    assert srs.GetAuthorityCode(None) == "25833"  # Berlin's srsName EPSG:25833 is projected: kept
+    assert srs.GetAuthorityCode(None) == "25832"  # Lorup's srsName (EPSG:25832 + height) is projected: kept
     assert ds.GetLayerByName("problems").GetGeomType() == ogr.wkbNone
 
 
@@ -89,7 +89,7 @@ def test_members_table_matches_the_id_lists(ds):
 def test_update_mode_gives_read_only_layers():
     # Issue 18: update access (QGIS probes it on every load) opens without an error, and nothing can be
     # written: the dataset makes no layer, its layers take no feature (test_driver_cache.py checks those).
-    ds = gdal.OpenEx(f"GROUNDPLAN:{BERLIN}", gdal.OF_VECTOR | gdal.OF_UPDATE)
+    ds = gdal.OpenEx(f"GROUNDPLAN:{LORUP}", gdal.OF_VECTOR | gdal.OF_UPDATE)
     assert not ds.TestCapability(ogr.ODsCCreateLayer) and not ds.TestCapability(ogr.ODsCDeleteLayer)
     with pytest.raises(RuntimeError, match="not supported"):
         ds.CreateLayer("x", geom_type=ogr.wkbPolygon)

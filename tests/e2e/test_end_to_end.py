@@ -6,9 +6,9 @@ import json
 import pytest
 from osgeo import gdal, ogr
 
-from conftest import BERLIN, BIN, LORUP, PLATEAU, PLATEAU_SMALL, SHARED_DATA, TUM, layer_rows, run
+from conftest import BERLIN, BIN, LORUP, PLATEAU, PLATEAU_SMALL, SHARED_DATA, TUM, layer_rows, run, thirdparty_data
 
-SAMPLES = [PLATEAU_SMALL, PLATEAU, LORUP, TUM, BERLIN]
+SAMPLES = [PLATEAU_SMALL, PLATEAU, LORUP, TUM, pytest.param(BERLIN, marks=thirdparty_data)]
 
 
 def test_plugin_is_listed_with_its_open_options():

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The GeoPackage spatial index the CLI packs itself (issue 14, driver/cli/gpkg_rtree.h) is the one GDAL's
+"""The GeoPackage spatial index the CLI packs itself (issue 14, driver/output/gpkg_rtree.h) is the one GDAL's
 own writer makes, seen from any reader: the same schema (tables, triggers, extension row, word for word),
 the same index entries (boxes rounded to float as SQLite rounds them), a tree SQLite's rtreecheck()
 accepts, the same answers to window queries, and triggers that keep it right when the file is edited."""
@@ -10,7 +10,7 @@ import sqlite3
 import pytest
 from osgeo import gdal, ogr
 
-from conftest import BERLIN, BIN, LORUP, PLATEAU, SHARED_DATA, run
+from conftest import BERLIN, BIN, LORUP, PLATEAU, SHARED_DATA, run, thirdparty_data
 
 INDEX = "rtree_{0}_geom"
 SCHEMA = "SELECT type, name, tbl_name, sql FROM sqlite_master ORDER BY type, name"
@@ -32,7 +32,8 @@ def entries(db, layer):
 
 
 @pytest.mark.skipif(not packs_index, reason="GDAL >= 3.7 builds the index itself")
-@pytest.mark.parametrize("src", [PLATEAU, LORUP, BERLIN, SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"],
+@pytest.mark.parametrize("src", [PLATEAU, LORUP, pytest.param(BERLIN, marks=thirdparty_data),
+                                 SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"],
                          ids=lambda p: p.name)
 def test_packed_index_is_the_one_gdal_makes(tmp_path, src):
     ours, ours_stats = write(tmp_path, "ours", src)

@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: MIT
-"""A new GeoPackage written by several writers side by side (issue 14, driver/cli/gpkg_slices.h) is the file one
+"""A new GeoPackage written by several writers side by side (issue 14, driver/output/gpkg_slices.h) is the file one
 writer makes, seen from any reader: the same schema, rows (FID, every field, the geometry blob byte for byte),
 extent, feature count and spatial index; no slice file is left beside it. Options whose effect spans features
 keep one writer, and --stats says which was used and why. By default the writers start while the union goes on
-(driver/cli/streamed_gpkg.h); --config GROUNDPLAN_WRITE_DURING_UNION NO writes after it: both give that file."""
+(driver/output/streamed_gpkg.h); --config GROUNDPLAN_WRITE_DURING_UNION NO writes after it: both give that file."""
 import json
 import sqlite3
 

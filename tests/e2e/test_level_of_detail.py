@@ -5,7 +5,7 @@ import json
 
 from osgeo import ogr
 
-from conftest import BERLIN, BIN, LORUP, TUM, layer_rows, run
+from conftest import BERLIN, BIN, LORUP, TUM, layer_rows, run, thirdparty_data
 
 LOD_FLAGS = ("--snap", "--close-gaps", "--min-hole-area", "--min-area", "--simplify", "--resolution-mode", "--preset")
 
@@ -41,12 +41,14 @@ def test_open_options_are_documented():
         assert option in doc, option
 
 
+@thirdparty_data
 def test_default_is_exact_and_stats_say_nothing_changed(tmp_path):
     j, _, _ = _stats(tmp_path, [], BERLIN)
     assert "level_of_detail" not in j
     assert j["counts"]["holes"] == 39  # the exact union keeps every sliver (sample_data/README.md)
 
 
+@thirdparty_data
 def test_snap_removes_slivers_and_verify_checks_validity(tmp_path):
     j, p, out = _stats(tmp_path, ["--snap", "0.001", "--verify"], BERLIN)
     lod = j["level_of_detail"]
@@ -101,6 +103,7 @@ def test_preset_cfd_and_explicit_flags_override_it(tmp_path):
     assert j2["level_of_detail"]["params"]["snap_m"] == 0.01
 
 
+@thirdparty_data
 def test_raster_mode_fills_holes_smaller_than_a_pixel(tmp_path):
     j, _, _ = _stats(tmp_path, ["--resolution", "1", "--resolution-mode", "raster"], BERLIN)
     raster = j["level_of_detail"]["raster"]

@@ -264,7 +264,7 @@ def test_nrw_like_tiles_over_4_ranks(tmp_path):
     check_plans(got, got[3], 4, tiles)
 
 
-# A new GeoPackage under mpirun (driver/cli/gpkg_rank_slices.h): every rank writes its own final plans into a slice
+# A new GeoPackage under mpirun (driver/output/gpkg_rank_slices.h): every rank writes its own final plans into a slice
 # beside rank 0's staged destination, and rank 0 appends the slices in FID order. The file must be the one rank 0
 # writes when it gathers every plan (forced here by -dim XY, an option that changes nothing in these 2D plans but
 # keeps one writer), in every respect test_gpkg_writers.py compares; and as sets, the plans of one process.

@@ -10,12 +10,12 @@ import json
 import pytest
 from osgeo import ogr
 
-from conftest import BIN, PLATEAU, SHARED_DATA, run
+from conftest import BIN, PLATEAU, SHARED_DATA, THIRDPARTY_DATA, run, thirdparty_data
 from test_ogr_input import _hostile_gpkg
 
 LAYERS = ["ground_plans", "footprints", "problems", "plan_members"]
 LORUP_TILES = SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles"
-BERLIN_LOD2 = SHARED_DATA / "citygml1-berlin-lod2-libcitygml"
+BERLIN_LOD2 = THIRDPARTY_DATA / "citygml1-berlin-lod2-libcitygml"
 
 
 def csv_hashes(tmp_path, name, src, *flags):
@@ -58,7 +58,7 @@ FORMATS = {"shp": ("ESRI Shapefile", ".shp"), "gpkg": ("GPKG", ".gpkg"), "geojso
 
 
 @pytest.mark.parametrize("fmt", sorted(FORMATS))
-@pytest.mark.parametrize("sample", ["lorup", "niiza", "berlin"])
+@pytest.mark.parametrize("sample", ["lorup", "niiza", pytest.param("berlin", marks=thirdparty_data)])
 def test_ranges_give_the_one_thread_files(tmp_path, real_footprints, sample, fmt):
     if sample not in real_footprints:
         pytest.skip(f"{sample} is not here")

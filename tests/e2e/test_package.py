@@ -93,3 +93,41 @@ def test_packaged_qgis_plugin_is_in_qgis_plugin_folder(root):
     assert "hasProcessingProvider=yes" in (plugin / "metadata.txt").read_text()
     python_dir = root / "usr" / "lib" / "python3" / "dist-packages" / "groundplan"
     assert (python_dir / "__init__.py").is_file(), "the plugin drives the Python module: it must be packaged too"
+
+
+def _elf_files(folder):
+    return [p for p in folder.rglob("*") if p.is_file() and not p.is_symlink() and p.read_bytes()[:4] == b"\x7fELF"]
+
+
+def test_nothing_packaged_needs_the_cuda_runtime(root):
+    """The package loads where CUDA is absent: no packaged binary needs libcudart or libcuda (the CUDA backend, where
+    built, is a module loaded when asked for, with the CUDA runtime linked in statically). packaging/
+    check-deb-without-cuda.sh goes further: it installs the package in a Debian chroot without CUDA and runs it."""
+    elfs = _elf_files(root)
+    assert {p.name for p in elfs} >= {"groundplan", "ogr_GroundPlan.so"}, elfs
+    for p in elfs:
+        needed = [l for l in subprocess.run(["readelf", "-d", str(p)], capture_output=True, text=True,
+                                            check=True).stdout.splitlines() if "(NEEDED)" in l]
+        assert needed, f"{p}: no NEEDED entries read"
+        assert not [l for l in needed if "libcudart" in l or "libcuda.so" in l], f"{p} needs CUDA: {needed}"
+
+
+def test_cmake_install_puts_the_module_on_debians_python_path(tmp_path):
+    """`cmake --install` with the default prefix (/usr/local) puts the Python module in a folder on the sys.path of
+    the python3 it is built for, and the QGIS plugin in QGIS's own plugin folder."""
+    if not BUILD_DIR or not (pathlib.Path(BUILD_DIR) / "python" / "groundplan").is_dir():
+        pytest.skip("the Python module is not built")
+    cache = (pathlib.Path(BUILD_DIR) / "CMakeCache.txt").read_text()
+    if "CMAKE_INSTALL_PREFIX:PATH=/usr/local\n" not in cache:
+        pytest.skip("the build is configured for another prefix than the default")
+    dest = tmp_path / "dest"
+    p = subprocess.run(["cmake", "--install", BUILD_DIR], capture_output=True, text=True, timeout=600,
+                       env=dict(os.environ, DESTDIR=str(dest)))
+    assert p.returncode == 0, p.stdout + p.stderr
+    inits = list(dest.glob("usr/local/**/groundplan/__init__.py"))
+    assert len(inits) == 1, inits
+    folder = "/" + str(inits[0].parent.parent.relative_to(dest))
+    path = subprocess.run(["/usr/bin/python3", "-c", "import sys; print('\\n'.join(sys.path))"], capture_output=True,
+                          text=True, check=True, env={"PATH": "/usr/bin:/bin"}).stdout.split()
+    assert folder in path, f"{folder} is not on Debian's python3 sys.path {path}"
+    assert (dest / "usr/share/qgis/python/plugins/groundplan_provider/metadata.txt").is_file()

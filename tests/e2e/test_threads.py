@@ -8,18 +8,18 @@ import json
 import pytest
 from osgeo import gdal
 
-from conftest import BIN, SAMPLES, SHARED_DATA, run
+from conftest import BIN, SAMPLES, SHARED_DATA, THIRDPARTY_DATA, real_sample_files, run, thirdparty_data
 
 LAYERS = ["ground_plans", "footprints", "problems", "plan_members"]
 
 
 def real_inputs():
-    files = sorted(p for root in (SAMPLES, SHARED_DATA) for p in root.rglob("*")
-                   if p.suffix in (".gml", ".citygml") and p.is_file())
+    files = real_sample_files((".gml", ".citygml"))
     # Folders: read side by side (CityJSON and CityJSONSeq files are read whole, but side by side too).
     folders = [SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", SHARED_DATA / "citygml2-plateau-japan-lod1",
                SHARED_DATA / "cityjson-3dbag-cjseq"]
-    return files + folders
+    thirdparty = [pytest.param(p, marks=thirdparty_data) for p in real_sample_files((".gml", ".citygml"), True)]
+    return files + folders + thirdparty
 
 
 def csv_hashes(tmp_path, name, src, *flags):
@@ -34,7 +34,7 @@ def csv_hashes(tmp_path, name, src, *flags):
         json.loads(stats.read_text())
 
 
-@pytest.mark.parametrize("src", real_inputs(), ids=lambda p: p.name)
+@pytest.mark.parametrize("src", real_inputs(), ids=lambda p: f"{p.parent.name}/{p.name}")
 def test_same_files_whatever_the_threads_and_the_cut(tmp_path, src):
     one, one_stats = csv_hashes(tmp_path, "one", src, "--threads", "1", "--read-chunk-bytes", "-1")
     many, many_stats = csv_hashes(tmp_path, "many", src, "--threads", "3", "--read-chunk-bytes", "16384")
@@ -46,10 +46,11 @@ def test_same_files_whatever_the_threads_and_the_cut(tmp_path, src):
     assert many == one
 
 
-XML_SAMPLES = [SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", SHARED_DATA / "citygml2-plateau-japan-lod1",
-               SHARED_DATA / "citygml1-berlin-lod2-libcitygml" / "berlin_open_data_sample_data.citygml",
-               SHARED_DATA / "citygml-citygml4j-samples" / "lod2_buildings_v3.gml",
-               SHARED_DATA / "citygml-ogc-spec-samples" / "Opera-Lyon_CityGML3.0_LOD2_with_xAL3_FreeText.gml"]
+XML_SAMPLES = [SHARED_DATA / "citygml1-niedersachsen-lod1-4tiles", SHARED_DATA / "citygml2-plateau-japan-lod1"] + [
+    pytest.param(THIRDPARTY_DATA / p, marks=thirdparty_data)
+    for p in ("citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml",
+              "citygml-citygml4j-samples/lod2_buildings_v3.gml",
+              "citygml-ogc-spec-samples/Opera-Lyon_CityGML3.0_LOD2_with_xAL3_FreeText.gml")]
 
 
 @pytest.mark.parametrize("src", XML_SAMPLES, ids=lambda p: p.name)

@@ -38,7 +38,7 @@ seed() {  # seed TARGET: fills $work/TARGET/seeds
         case $f in *.kml) p='\x00' ;; *.kmz) p='\x01' ;; *.dae) p='\x02' ;; *.gltf) p='\x03' ;; esac
         { printf "$p"; cat "$f"; } > "$d/seed$((i++))"
       done
-      for f in ../shared/data/cityjson-3dbag-cjseq/*.city.json*; do  # CityJSON (\x05), CityJSONSeq (\x06)
+      for f in tests/data/cityjson-3dbag-cjseq/*.city.json*; do  # CityJSON (\x05), CityJSONSeq (\x06)
         [ -f "$f" ] || continue
         case $f in *.jsonl) p='\x06' ;; *) p='\x05' ;; esac
         { printf "$p"; cat "$f"; } > "$d/seed$((i++))"

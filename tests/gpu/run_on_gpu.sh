@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 4 on a GPU machine, one script per device call: tools check, build (full CMake build when
+# The CUDA backend on a GPU machine, one script per device call: tools check, build (full CMake build when
 # the GIS -dev packages are there, else bench_blocks alone with nvcc: it needs only the raster
 # sources), CUDA-vs-CPU tests, and blocks timings at 6k, 100k and 1M footprints on GPU and CPU.
 # Logs go to $OUT (or ./gpu-out). Run from the repository root.
@@ -35,17 +35,23 @@ if [ -z "$BENCH" ]; then
   mkdir -p build-standalone && cd build-standalone || exit 1
   R=..; inc="-I$R/core/include -I$R/core/src -I$R/tests/support"; [ $have_tbb = 1 ] && lib="-ltbb" || inc="$inc -I$R/tests/gpu/tbb_shim"
   # .cpp with g++ as in the CMake build (nvcc's own C++ pass finds std::apply by ADL in the generators)
-  for f in core/src/blocks/cpu_raster_backend.cpp core/src/blocks/raster_common.cpp tests/support/union_generators.cpp; do
-    g++ -std=c++20 -O2 -ffp-contract=off $inc -c $R/$f -o $(basename $f).o || exit 1
+  # the CUDA backend is a module loaded by core (libgroundplan_cuda.so.0, found here through LD_LIBRARY_PATH)
+  export LD_LIBRARY_PATH=$PWD${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+  build='-DGROUNDPLAN_CUDA_MODULE_BUILD="standalone"'
+  for f in core/src/blocks/cpu_raster_backend.cpp core/src/blocks/raster_common.cpp tests/support/union_generators.cpp \
+           core/src/raster_backend_factory.cpp core/src/blocks/cuda_module.cpp; do
+    g++ -std=c++20 -O2 -fPIC -ffp-contract=off "$build" $inc -c $R/$f -o $(basename $f).o || exit 1
   done
-  g++ -std=c++20 -O2 -ffp-contract=off -DGROUNDPLAN_HAVE_CUDA=1 $inc -c $R/core/src/raster_backend_factory.cpp -o factory.o &&
-  nvcc -std=c++20 -O2 -arch=sm_90 --fmad=false -Xcompiler=-ffp-contract=off $inc -c $R/gpu/src/cuda_raster_backend.cu -o cuda.o &&
+  nvcc -std=c++20 -O2 -arch=sm_90 --fmad=false -Xcompiler=-ffp-contract=off,-fPIC "$build" $inc -c \
+    $R/gpu/src/cuda_raster_backend.cu -o cuda.o &&
+  nvcc -shared -arch=sm_90 -cudart static cuda.o raster_common.cpp.o -o libgroundplan_cuda.so.0 &&
   g++ -std=c++20 -O2 $inc -c $R/tests/bench/bench_blocks.cpp -o bench.o &&
-  nvcc -arch=sm_90 bench.o cpu_raster_backend.cpp.o raster_common.cpp.o union_generators.cpp.o factory.o cuda.o $lib -o bench_blocks &&
+  g++ bench.o cpu_raster_backend.cpp.o raster_common.cpp.o union_generators.cpp.o raster_backend_factory.cpp.o \
+    cuda_module.cpp.o $lib -ldl -o bench_blocks &&
     BENCH=build-standalone/bench_blocks
-  if g++ -std=c++20 -O2 -DGROUNDPLAN_TEST_CUDA_BUILT=1 $inc -c $R/tests/gpu/cuda_raster_backend_test.cpp -o gput.o &&
-     nvcc -arch=sm_90 gput.o cpu_raster_backend.cpp.o raster_common.cpp.o union_generators.cpp.o factory.o cuda.o $lib \
-       -lgtest -lgtest_main -Xcompiler=-pthread -o gpu_tests; then
+  if g++ -std=c++20 -O2 $inc -c $R/tests/gpu/cuda_raster_backend_test.cpp -o gput.o &&
+     g++ gput.o cpu_raster_backend.cpp.o raster_common.cpp.o union_generators.cpp.o raster_backend_factory.cpp.o \
+       cuda_module.cpp.o $lib -ldl -lgtest -lgtest_main -pthread -o gpu_tests; then
     echo "== gpu tests (standalone)"; ./gpu_tests 2>&1 | tail -25
   else echo "gpu tests: no gtest library to link"; fi
   cd ..

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "known_footprints.h"
 
+#include <groundplan/types.h>
+
 #include <algorithm>
 #include <array>
 #include <functional>
@@ -176,12 +178,137 @@ Model disconnected() {
   return m;
 }
 
+/// A building of one closed mesh on a plan grid (lines xs, ys): cell (i, j) is solid from bottom[j][i] to
+/// top[j][i] (top 0: empty). Stacked parts (plinth, podium, terraces, towers on a base) and arcades (cells
+/// raised on pillars) as exporters write them without semantics: one solid, each side of a cell a wall
+/// between its own and its neighbour's extent, every face's corners including each height where another
+/// face meets its vertical edges (no T-junctions), bottoms at z 0 on the ground.
+struct Cells {
+  std::vector<double> xs, ys;
+  std::vector<std::vector<std::array<double, 2>>> z;  // [j][i] = {bottom, top}
+};
+
+Model cells_model(const Cells& c, std::string true_wkt, double true_area, double shadow_area) {
+  Model m{{}, std::move(true_wkt), true_area, shadow_area};
+  const int nx = static_cast<int>(c.xs.size()) - 1, ny = static_cast<int>(c.ys.size()) - 1;
+  auto cell = [&](int i, int j) -> std::array<double, 2> {
+    if (i < 0 || j < 0 || i >= nx || j >= ny || c.z[j][i][1] <= 0) return {0, 0};
+    return c.z[j][i];
+  };
+  // Heights met at grid corner (i, j): the bottoms and tops of the four cells around it.
+  auto corner_heights = [&](int i, int j) {
+    std::vector<double> h;
+    for (int di : {-1, 0})
+      for (int dj : {-1, 0}) {
+        const auto e = cell(i + di, j + dj);
+        if (e[1] > 0) h.insert(h.end(), {e[0], e[1]});
+      }
+    std::sort(h.begin(), h.end());
+    h.erase(std::unique(h.begin(), h.end()), h.end());
+    return h;
+  };
+  // Wall along the cell side from corner p to corner q (counter-clockwise round the cell: outside on the
+  // right), z0..z1, with the corner heights strictly between on its vertical edges.
+  auto side_wall = [&](int pi, int pj, int qi, int qj, double z0, double z1) {
+    const Point2 p{c.xs[pi], c.ys[pj]}, q{c.xs[qi], c.ys[qj]};
+    Ring3 r{{p.x, p.y, z0}, {q.x, q.y, z0}};
+    for (double h : corner_heights(qi, qj))
+      if (h > z0 && h < z1) r.push_back({q.x, q.y, h});
+    r.push_back({q.x, q.y, z1});
+    r.push_back({p.x, p.y, z1});
+    std::vector<double> hp = corner_heights(pi, pj);
+    for (auto it = hp.rbegin(); it != hp.rend(); ++it)
+      if (*it > z0 && *it < z1) r.push_back({p.x, p.y, *it});
+    m.faces.push_back({r});
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const auto e = cell(i, j);
+      if (e[1] <= 0) continue;
+      m.faces.push_back(flat(c.xs[i], c.ys[j], c.xs[i + 1], c.ys[j + 1], e[1], true));
+      m.faces.push_back(flat(c.xs[i], c.ys[j], c.xs[i + 1], c.ys[j + 1], e[0], false, e[0] == 0));
+      // Sides counter-clockwise: south, east, north, west; the neighbour across each.
+      const int sides[4][6] = {{i, j, i + 1, j, i, j - 1},
+                               {i + 1, j, i + 1, j + 1, i + 1, j},
+                               {i + 1, j + 1, i, j + 1, i, j + 1},
+                               {i, j + 1, i, j, i - 1, j}};
+      for (const auto& s : sides) {
+        const auto n = cell(s[4], s[5]);
+        // This cell's extent less the neighbour's: below it and above it.
+        if (n[1] <= 0 || n[0] >= e[1] || n[1] <= e[0]) {
+          side_wall(s[0], s[1], s[2], s[3], e[0], e[1]);
+          continue;
+        }
+        if (n[0] > e[0]) side_wall(s[0], s[1], s[2], s[3], e[0], n[0]);
+        if (n[1] < e[1]) side_wall(s[0], s[1], s[2], s[3], n[1], e[1]);
+      }
+    }
+  return m;
+}
+
+/// A 3 x 3 grid of cells, every one {0, base} but the middle {0, middle}.
+std::vector<std::vector<std::array<double, 2>>> base_and_middle(double base, double middle) {
+  std::vector<std::vector<std::array<double, 2>>> z(3, std::vector<std::array<double, 2>>(3, {0, base}));
+  z[1][1] = {0, middle};
+  return z;
+}
+
+/// A 1.3 m plinth (30 x 30) under a 15 x 15 tower 40 m high, one closed mesh: the ground is the plinth's.
+Model plinth() {
+  return cells_model({{0, 7.5, 22.5, 30}, {0, 7.5, 22.5, 30}, base_and_middle(1.3, 40)},
+                     "POLYGON((0 0,30 0,30 30,0 30,0 0))", 900, 900);
+}
+
+/// A 12 m podium (40 x 35) with a 20 x 15 tower of 60 m on it, off centre.
+Model podium() {
+  return cells_model({{0, 10, 30, 40}, {0, 10, 25, 35}, base_and_middle(12, 60)}, "POLYGON((0 0,40 0,40 35,0 35,0 0))",
+                     1400, 1400);
+}
+
+/// A 6 m podium (30 x 20) with a 10 x 10 tower of 50 m flush with its north-east corner: the tower's outer walls
+/// and the podium's are one plane there.
+Model podium_corner() {
+  std::vector<std::vector<std::array<double, 2>>> z(2, std::vector<std::array<double, 2>>(2, {0, 6}));
+  z[1][1] = {0, 50};
+  return cells_model({{0, 20, 30}, {0, 10, 20}, z}, "POLYGON((0 0,30 0,30 20,0 20,0 0))", 600, 600);
+}
+
+/// Terraces: three storeys set back 5 m on every side (30 x 20, 4 / 8 / 16 m).
+Model terraces() {
+  std::vector<std::vector<std::array<double, 2>>> z(4, std::vector<std::array<double, 2>>(6, {0, 4}));
+  for (int j = 1; j < 3; ++j)
+    for (int i = 1; i < 5; ++i) z[j][i] = {0, (i >= 2 && i <= 3) ? 16.0 : 8.0};
+  return cells_model({{0, 5, 10, 20, 25, 30}, {0, 5, 15, 20}, z}, "POLYGON((0 0,30 0,30 20,0 20,0 0))", 600, 600);
+}
+
+/// Two towers (10 x 10, 30 m and 45 m) on one 6 m base (50 x 20).
+Model multi_tower() {
+  std::vector<std::vector<std::array<double, 2>>> z(3, std::vector<std::array<double, 2>>(5, {0, 6}));
+  z[1][1] = {0, 30};
+  z[1][3] = {0, 45};
+  return cells_model({{0, 5, 15, 35, 45, 50}, {0, 5, 15, 20}, z}, "POLYGON((0 0,50 0,50 20,0 20,0 0))", 1000, 1000);
+}
+
+/// An arcade: a 10 x 10 block, 12 m high, whose ground floor is set back 3 m from the street (y 0) behind two
+/// 0.5 x 0.5 m pillars; the storeys above reach over the arcade. The footprint is the ground floor and the
+/// pillars (70.5 m²), not the shadow (100 m²).
+Model arcade() {
+  const std::array<double, 2> up{3, 12}, full{0, 12};
+  std::vector<std::vector<std::array<double, 2>>> z(3, std::vector<std::array<double, 2>>(5, up));
+  z[0][1] = full;  // pillars
+  z[0][3] = full;
+  for (auto& e : z[2]) e = full;  // the ground floor behind the arcade
+  return cells_model({{0, 2, 2.5, 7.5, 8, 10}, {0, 0.5, 3, 10}, z},
+                     "MULTIPOLYGON(((0 3,10 3,10 10,0 10,0 3)),((2 0,2.5 0,2.5 0.5,2 0.5,2 0)),((7.5 0,8 0,8 0.5,7.5 0.5,7.5 0)))",
+                     70.5, 100);
+}
+
 struct Family {
   const char* name;
   Model (*make)();
 };
 
-constexpr std::array<Family, 10> kFamilies{{{"eaves_open", eaves_open},
+constexpr std::array<Family, 16> kFamilies{{{"eaves_open", eaves_open},
                                           {"eaves_soffit", eaves_soffit},
                                           {"slab_roof", slab_roof},
                                           {"cantilever", cantilever},
@@ -190,13 +317,36 @@ constexpr std::array<Family, 10> kFamilies{{{"eaves_open", eaves_open},
                                           {"stacked_boxes", stacked_boxes},
                                           {"stacked_overhang", stacked_overhang},
                                           {"stacked_corner", stacked_corner},
-                                          {"disconnected", disconnected}}};
+                                          {"disconnected", disconnected},
+                                          {"plinth", plinth},
+                                          {"podium", podium},
+                                          {"podium_corner", podium_corner},
+                                          {"terraces", terraces},
+                                          {"multi_tower", multi_tower},
+                                          {"arcade", arcade}}};
 
-/// Convex faces fanned into triangles (corners shared bit for bit, orientation kept).
+/// Whether three corners lie on one line.
+bool collinear(const Point3& a, const Point3& b, const Point3& c) {
+  const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+  return uy * vz - uz * vy == 0 && uz * vx - ux * vz == 0 && ux * vy - uy * vx == 0;
+}
+
+/// Convex faces fanned into triangles (corners shared bit for bit, orientation kept). A face with corners in
+/// a line (a wall with the heights of its neighbours on its edges) is fanned from its centre instead, which
+/// no corner lies in a line with.
 std::vector<Ring3> triangles(const std::vector<Ring3>& faces) {
   std::vector<Ring3> out;
-  for (const Ring3& f : faces)
-    for (std::size_t k = 1; k + 1 < f.size(); ++k) out.push_back({f[0], f[k], f[k + 1]});
+  for (const Ring3& f : faces) {
+    bool straight = false;
+    for (std::size_t k = 0; k < f.size(); ++k) straight |= collinear(f[k], f[(k + 1) % f.size()], f[(k + 2) % f.size()]);
+    if (!straight) {
+      for (std::size_t k = 1; k + 1 < f.size(); ++k) out.push_back({f[0], f[k], f[k + 1]});
+      continue;
+    }
+    Point3 c{0, 0, 0};
+    for (const Point3& p : f) c = {c.x + p.x / f.size(), c.y + p.y / f.size(), c.z + p.z / f.size()};
+    for (std::size_t k = 0; k < f.size(); ++k) out.push_back({c, f[k], f[(k + 1) % f.size()]});
+  }
   return out;
 }
 

@@ -28,7 +28,8 @@ struct KnownFootprint {
 };
 
 /// The families, in order: eaves_open, eaves_soffit, slab_roof, cantilever, balcony, stepped_ground,
-/// stacked_boxes, stacked_overhang, stacked_corner, disconnected.
+/// stacked_boxes, stacked_overhang, stacked_corner, disconnected, and one closed mesh each: plinth, podium,
+/// podium_corner, terraces, multi_tower, arcade.
 std::vector<std::string> known_footprint_families();
 
 /// Every family x writing x floor, deterministic (fixed seeds).

@@ -13,9 +13,6 @@
 
 namespace groundplan::test {
 
-std::string shared_data(const std::string& relative) { return std::string(GROUNDPLAN_SHARED_DATA_DIR) + "/" + relative; }
-std::string sample_data(const std::string& relative) { return std::string(GROUNDPLAN_SAMPLE_DATA_DIR) + "/" + relative; }
-
 TempDir::TempDir(const std::string& prefix) {
   static int n = 0;
   path = std::filesystem::temp_directory_path() /

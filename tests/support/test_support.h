@@ -8,12 +8,9 @@
 #include <string>
 #include <vector>
 
-namespace groundplan::test {
+#include "real_samples.h"  // sample_data, shared_data: where the real city models are
 
-/// Path of a file under ../shared/data (read-only third-party samples; CI reads them in place).
-std::string shared_data(const std::string& relative);
-/// Path of a file under sample_data/.
-std::string sample_data(const std::string& relative);
+namespace groundplan::test {
 
 /// Footprints from WKT polygons, one footprint per string, ids "f0", "f1", ...
 std::vector<Footprint> footprints_from_wkt(const std::vector<std::string>& wkts);

@@ -5,6 +5,7 @@
 #include <groundplan/footprint.h>
 
 #include "footprint/decompose.h"
+#include "footprint/ground_check.h"
 
 #include <algorithm>
 #include <cmath>
@@ -102,6 +103,9 @@ bool decompose_into(const Mesh& mesh, const FootprintParams& params, FootprintRe
     res.footprint.polygons = std::move(d.polygons);
     res.ok = true;
     res.method = d.stats.shadow ? FootprintMethod::DecompositionShadow : FootprintMethod::Decomposition;
+    // Not trusted: the lowest horizontal faces must lie inside it (ground_check.h).
+    const footprint::GroundCheck g = footprint::check_ground(mesh, res.footprint.polygons, params);
+    if (g.misses_ground()) res.misses_ground = g.reason();
     if (d.stats.shadow) {
       // Issue 21: say why the wall loops were not taken (the shadow also covers every overhang).
       char buf[400];

@@ -307,7 +307,7 @@ void append_parts(std::vector<Part>& parts, const std::string& file, FileRead& o
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t k) {
     std::size_t kept = 0, i = 0;
     for (const Part::Slot& slot : parts[k].slots) {
-      if (!slot.fp.ok || !slot.fp.note.empty()) telling[k].push_back({i, kept});
+      if (!slot.fp.ok || !slot.fp.note.empty() || !slot.fp.misses_ground.empty()) telling[k].push_back({i, kept});
       if (slot.fp.ok) ++kept;
       ++i;
     }
@@ -333,9 +333,13 @@ void append_parts(std::vector<Part>& parts, const std::string& file, FileRead& o
       Part::Slot& slot = part.slots[t.slot];
       FootprintResult& fp = slot.fp;
       if (fp.ok) {  // kept (its footprint moved already), but found by a last resort: say why the earlier methods failed
-        out.problems.push_back({out.footprints[first[k] + t.kept_before].source_id, file, "footprint",
-                                fp.method == FootprintMethod::DecompositionShadow ? "FOOTPRINT_SHADOW" : "FOOTPRINT_CLOSED_IN_PLAN",
-                                fp.note});
+        const std::string& id = out.footprints[first[k] + t.kept_before].source_id;
+        if (!fp.note.empty())
+          out.problems.push_back({id, file, "footprint",
+                                  fp.method == FootprintMethod::DecompositionShadow ? "FOOTPRINT_SHADOW" : "FOOTPRINT_CLOSED_IN_PLAN",
+                                  fp.note});
+        // and a footprint that leaves out ground the building stands on (footprint/ground_check.h)
+        if (!fp.misses_ground.empty()) out.problems.push_back({id, file, "footprint", "FOOTPRINT_MISSES_GROUND", fp.misses_ground});
         continue;
       }
       for (; next < slot.problem_pos; ++next) out.problems.push_back(std::move(part.problems[next]));

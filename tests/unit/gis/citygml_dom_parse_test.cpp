@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "test_config.h"
+#include "test_support.h"
 #include "xml/dom_events.h"
 
 #include <cstring>
@@ -92,28 +92,27 @@ void expect_same(const Outcome& dom, const Outcome& expat, const std::string& wh
   EXPECT_EQ(dom.info.bytes, expat.info.bytes) << what;
 }
 
-std::vector<std::string> citygml_files() {
+std::vector<std::string> citygml_files(test::Samples which) {
   std::vector<std::string> files;
-  for (const std::string& root : {std::string(GROUNDPLAN_SAMPLE_DATA_DIR), std::string(GROUNDPLAN_SHARED_DATA_DIR)}) {
-    if (!fs::is_directory(root)) continue;
-    for (const auto& e : fs::recursive_directory_iterator(root)) {
-      if (!e.is_regular_file()) continue;
-      const std::string ext = e.path().extension().string();
-      if (ext != ".gml" && ext != ".xml" && ext != ".citygml") continue;
-      std::ifstream in(e.path(), std::ios::binary);
-      std::string head(4096, '\0');
-      in.read(head.data(), static_cast<std::streamsize>(head.size()));
-      head.resize(static_cast<std::size_t>(in.gcount()));
-      if (looks_like_citygml(head)) files.push_back(e.path().string());
-    }
+  for (const std::string& f : test::real_sample_files(which, {".gml", ".xml", ".citygml"})) {
+    std::ifstream in(f, std::ios::binary);
+    std::string head(4096, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    if (looks_like_citygml(head)) files.push_back(f);
   }
-  std::sort(files.begin(), files.end());
   return files;
 }
 
-TEST(CityGmlInMemory, EveryRealSampleReadsAsExpatReadsIt) {
-  const std::vector<std::string> files = citygml_files();
-  ASSERT_GE(files.size(), 20u) << "the real samples are missing";
+// Once over the samples in the repository, once over the third-party ones (ThirdParty/..., skipped without them).
+class CityGmlInMemorySamples : public ::testing::TestWithParam<test::Samples> {};
+INSTANTIATE_TEST_SUITE_P(InRepo, CityGmlInMemorySamples, ::testing::Values(test::Samples::InRepo));
+INSTANTIATE_TEST_SUITE_P(ThirdParty, CityGmlInMemorySamples, ::testing::Values(test::Samples::ThirdParty));
+
+TEST_P(CityGmlInMemorySamples, EveryRealSampleReadsAsExpatReadsIt) {
+  GROUNDPLAN_SKIP_IF_NO_SAMPLES(GetParam());
+  const std::vector<std::string> files = citygml_files(GetParam());
+  ASSERT_GE(files.size(), 10u) << "the real samples are missing";
   std::size_t in_memory = 0, meshes = 0;
   for (const std::string& f : files) {
     const Outcome dom = read_path(f, true), expat = read_path(f, false);

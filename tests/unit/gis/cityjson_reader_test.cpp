@@ -417,7 +417,8 @@ TEST(CityJsonReal, ThreeDBagFileAndSequenceGiveTheSamePlans) {
   EXPECT_NEAR(plan_area(dec), plan_area(whole), 1e-3 * plan_area(whole));
 }
 
-TEST(CityJsonReal, Citygml4jCityJsonGivesTheSamePlansAsItsCityGml) {
+TEST(CityJsonRealThirdParty, Citygml4jCityJsonGivesTheSamePlansAsItsCityGml) {
+  GROUNDPLAN_SKIP_IF_MISSING(test::shared_data("citygml-citygml4j-samples/lod2_buildings_v2.json"));
   gis::PipelineOptions o;
   o.inputs = {test::shared_data("citygml-citygml4j-samples/lod2_buildings_v2.json")};
   const gis::PipelineResult json = gis::run_pipeline(o);

@@ -15,6 +15,7 @@
 #include <iterator>
 #include <string>
 #include <vector>
+#include <vector>
 
 #include "read_all.h"
 #include "test_support.h"
@@ -65,11 +66,8 @@ TEST(CompressedInput, NamesAndFormats) {
 
 // Real samples, gzipped into a temporary folder: the same plans, footprints and CRS as the plain file,
 // alone and as a folder of tiles.
-TEST(CompressedInput, RealSamplesGiveWhatThePlainFileGives) {
-  const test::TempDir dir("groundplan_gz_test");
-  for (const std::string rel : {"cityjson-3dbag-cjseq/3dbag_b2.city.json", "cityjson-3dbag-cjseq/3dbag_b2.city.jsonl",
-                                "citygml-fzkhaus-denhaag-misc/FZK-Haus-LoD2-KIT-IAI-KHH-B36-V1__v3.gml",
-                                "citygml-ogc-spec-samples/v2_Building_and_garage_LOD2-EPSG25832.gml"}) {
+void expect_gzipped_gives_plain(const test::TempDir& dir, const std::vector<std::string>& samples) {
+  for (const std::string& rel : samples) {
     const std::string plain = test::shared_data(rel);
     const bool bag = rel.find("3dbag") != std::string::npos;  // one CRS to a folder
     std::filesystem::create_directories(dir.path / (bag ? "bag" : "gml"));
@@ -83,6 +81,28 @@ TEST(CompressedInput, RealSamplesGiveWhatThePlainFileGives) {
     EXPECT_EQ(a.crs_name, b.crs_name) << rel;
     EXPECT_EQ(a.problems.size(), b.problems.size()) << rel;
   }
+}
+
+/// Nothing is written beside the inputs (GDAL's x.gz.properties cache is off while reading them).
+void expect_no_properties_files(const test::TempDir& dir) {
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path))
+    EXPECT_NE(e.path().extension(), ".properties") << e.path();
+}
+
+TEST(CompressedInput, RealSamplesGiveWhatThePlainFileGives) {
+  const test::TempDir dir("groundplan_gz_test");
+  expect_gzipped_gives_plain(dir, {"cityjson-3dbag-cjseq/3dbag_b2.city.json", "cityjson-3dbag-cjseq/3dbag_b2.city.jsonl",
+                                   "citygml-fzkhaus-denhaag-misc/TUM-Main-Entrance.gml"});
+  expect_no_properties_files(dir);
+  // A folder of tiles: its .gz files found by name.
+  EXPECT_EQ(run((dir.path / "bag").string()).buildings_read, 2 * run(test::shared_data("cityjson-3dbag-cjseq/3dbag_b2.city.json")).buildings_read);
+}
+
+TEST(CompressedInputThirdParty, RealSamplesGiveWhatThePlainFileGives) {
+  GROUNDPLAN_SKIP_IF_MISSING(test::shared_data("kml-collada-korea-mago/sample-kml/a_bd001.kml"));
+  const test::TempDir dir("groundplan_gz_test");
+  expect_gzipped_gives_plain(dir, {"citygml-fzkhaus-denhaag-misc/FZK-Haus-LoD2-KIT-IAI-KHH-B36-V1__v3.gml",
+                                   "citygml-ogc-spec-samples/v2_Building_and_garage_LOD2-EPSG25832.gml"});
   // A KML whose COLLADA model lies beside it: the model is found beside the .kml.gz, not inside /vsigzip/.
   std::filesystem::create_directories(dir.path / "kml");
   const std::string kml = test::shared_data("kml-collada-korea-mago/sample-kml/a_bd001.kml");
@@ -92,12 +112,7 @@ TEST(CompressedInput, RealSamplesGiveWhatThePlainFileGives) {
   ASSERT_EQ(k.footprints.size(), 1u);
   EXPECT_EQ(test::plan_keys(k.plans), test::plan_keys(kgz.plans));
   EXPECT_EQ(kgz.problems.size(), k.problems.size());
-  // Nothing is written beside the inputs (GDAL's x.gz.properties cache is off while reading them).
-  for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path))
-    EXPECT_NE(e.path().extension(), ".properties") << e.path();
-
-  // A folder of tiles: its .gz files found by name.
-  EXPECT_EQ(run((dir.path / "bag").string()).buildings_read, 2 * run(test::shared_data("cityjson-3dbag-cjseq/3dbag_b2.city.json")).buildings_read);
+  expect_no_properties_files(dir);
 }
 
 // A gzip bomb: 16 MB of blanks inside valid documents pack to ~16 KB; with the ratio at 100 and the floor

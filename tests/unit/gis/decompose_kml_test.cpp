@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "test_config.h"
+#include "test_support.h"
 
 namespace groundplan {
 namespace {
 
 std::vector<Mesh> read_meshes(const std::string& rel) {
-  const std::string path = std::string(GROUNDPLAN_SHARED_DATA_DIR) + "/" + rel;
+  const std::string path = test::shared_data(rel);
   std::vector<Mesh> meshes;
   std::vector<Problem> problems;
   gis::ReadInfo info;
@@ -113,9 +113,10 @@ TEST(DecomposeKml, MackyNormalKmzGivesTheSameFootprint) {
 // The Korea models (FBX-exported triangles): a podium 1.7 m high whose closed ground loop is the
 // footprint, and a part at 81 m whose base (80.7 m², inside the podium) closes too; its open chains
 // lie inside the podium's loop, so no shadow. Areas: the podium outline (10 vertices) as measured.
-TEST(DecomposeKml, KoreaModelsKeepTheirClosedGroundLoop) {
+TEST(DecomposeKmlThirdParty, KoreaModelsKeepTheirClosedGroundLoop) {
   const char* files[] = {"kml-collada-korea-mago/sample-kml/a_bd001.kml", "kml-collada-korea-mago/sample-kml/a_bd002.kml",
                          "kml-collada-korea-mago/sample-kml/a_bd003.kml"};
+  GROUNDPLAN_SKIP_IF_MISSING(test::shared_data(files[0]));
   for (const char* f : files) {
     SCOPED_TRACE(f);
     const std::vector<Mesh> meshes = read_meshes(f);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // KML / KMZ + COLLADA reader and model placement (issue 6): every KML/KMZ/COLLADA sample in
-// ../shared/data, small files made here for each feature (a unit cube in a KMZ at a known lon/lat,
+// tests/data/ (and the third-party folder), small files made here for each feature (a unit cube in a KMZ at a known lon/lat,
 // a Y_UP inch COLLADA, heading), and hostile input (escaping hrefs, URLs, zip bombs, broken indices).
 // KMZ files are written by a minimal stored-zip writer below, so that hostile entry names and
 // forged sizes can be made at will.
@@ -16,7 +16,6 @@
 #include <proj.h>
 
 #include "read_all.h"
-#include "test_config.h"
 
 #include <unistd.h>
 
@@ -34,7 +33,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string shared(const std::string& rel) { return std::string(GROUNDPLAN_SHARED_DATA_DIR) + "/" + rel; }
+using test::shared_data;
+
+std::string pipeline_problems(const PipelineResult& r) {
+  std::string all;
+  for (const Problem& p : r.problems) all += p.code + ": " + p.reason + "\n";
+  return all;
+}
+
+std::size_t count_code(const PipelineResult& r, const std::string& code) {
+  std::size_t n = 0;
+  for (const Problem& p : r.problems) n += p.code == code;
+  return n;
+}
 
 // ---------------------------------------------------------------------------------------------------
 // Helpers: stored zip writer, PROJ oracle (the temp folder: test::TempDir).
@@ -163,11 +174,11 @@ std::string model_kml(double lon, double lat, const std::string& href, const std
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Real samples (counts: ../shared/data/kml-collada-*/SOURCE.txt).
+// Real samples (counts: tests/data/kml-collada-macky-google/SOURCE.txt; Korea: the third-party folder).
 
 TEST(KmlRealData, MackyKmzLandsInBoulderInUtm13WithInchesHonoured) {
   for (const char* kmz : {"macky-normal.kmz", "model-macky.kmz"}) {
-    const Read r = read(shared(std::string("kml-collada-macky-google/") + kmz));
+    const Read r = read(shared_data(std::string("kml-collada-macky-google/") + kmz));
     ASSERT_EQ(r.meshes.size(), 1u) << kmz << "\n" << r.all();
     EXPECT_EQ(r.info.format, InputFormat::Kmz);
     EXPECT_TRUE(r.info.in_working_crs);
@@ -189,7 +200,7 @@ TEST(KmlRealData, MackyKmzLandsInBoulderInUtm13WithInchesHonoured) {
 }
 
 TEST(KmlRealData, SharedTexturesKmzHasTwoModelsInOneFolder) {
-  const Read r = read(shared("kml-collada-macky-google/shared-textures.kmz"));
+  const Read r = read(shared_data("kml-collada-macky-google/shared-textures.kmz"));
   ASSERT_EQ(r.meshes.size(), 2u) << r.all();
   EXPECT_EQ(r.meshes[0].source_id, "building");
   EXPECT_EQ(r.meshes[1].source_id, "wall");
@@ -202,8 +213,9 @@ TEST(KmlRealData, SharedTexturesKmzHasTwoModelsInOneFolder) {
   }
 }
 
-TEST(KmlRealData, KoreaKmlBesideDaeThreeBuildings) {
-  const std::string dir = shared("kml-collada-korea-mago/sample-kml/");
+TEST(KmlRealDataThirdParty, KoreaKmlBesideDaeThreeBuildings) {
+  const std::string dir = shared_data("kml-collada-korea-mago/sample-kml/");
+  GROUNDPLAN_SKIP_IF_MISSING(dir);
   for (const char* kml : {"a_bd001.kml", "a_bd002.kml", "a_bd003.kml"}) {
     const Read r = read(dir + kml);
     ASSERT_EQ(r.meshes.size(), 1u) << kml << "\n" << r.all();
@@ -218,8 +230,9 @@ TEST(KmlRealData, KoreaKmlBesideDaeThreeBuildings) {
   }
 }
 
-TEST(KmlRealData, KoreaErrorCaseOneModelAndTwoMissingLinks) {
-  const std::string dir = shared("kml-collada-korea-mago/sample-kml-error-case/");
+TEST(KmlRealDataThirdParty, KoreaErrorCaseOneModelAndTwoMissingLinks) {
+  const std::string dir = shared_data("kml-collada-korea-mago/sample-kml-error-case/");
+  GROUNDPLAN_SKIP_IF_MISSING(dir);
   std::size_t meshes = 0, missing = 0;
   for (const char* kml : {"a_bd001.kml", "a_bd002.kml", "a_bd003.kml"}) {
     const Read r = read(dir + kml);
@@ -235,7 +248,7 @@ TEST(KmlRealData, KoreaErrorCaseOneModelAndTwoMissingLinks) {
 }
 
 TEST(KmlRealData, StandaloneDaeNeedsAnOrigin) {
-  const std::string dae = shared("kml-collada-macky-google/standalone_dae/cu_macky/CU Macky.dae");
+  const std::string dae = shared_data("kml-collada-macky-google/standalone_dae/cu_macky/CU Macky.dae");
   try {
     read(dae);
     FAIL() << "no exception";
@@ -252,22 +265,14 @@ TEST(KmlRealData, StandaloneDaeNeedsAnOrigin) {
   EXPECT_LT(b.dx(), 150.0);
 }
 
-TEST(KmlRealData, PipelineEndToEndOnKmzAndKmlFolders) {
+TEST(KmlRealData, PipelineEndToEndOnKmz) {
   PipelineOptions options;
   PipelineResult r;
-  auto problems = [&] {
-    std::string all;
-    for (const Problem& p : r.problems) all += p.code + ": " + p.reason + "\n";
-    return all;
-  };
-  auto count = [&](const std::string& code) {
-    std::size_t n = 0;
-    for (const Problem& p : r.problems) n += p.code == code;
-    return n;
-  };
+  auto problems = [&] { return pipeline_problems(r); };
+  auto count = [&](const std::string& code) { return count_code(r, code); };
   // Macky: placed and in the working CRS; its SketchUp triangle soup is the footprint stage's
   // business: a footprint or a footprint Problem, never lost.
-  options.inputs = {shared("kml-collada-macky-google/macky-normal.kmz")};
+  options.inputs = {shared_data("kml-collada-macky-google/macky-normal.kmz")};
   r = run_pipeline(options);
   EXPECT_EQ(r.buildings_read, 1u);
   EXPECT_EQ(r.crs_name, "EPSG:32613");
@@ -286,8 +291,15 @@ TEST(KmlRealData, PipelineEndToEndOnKmzAndKmlFolders) {
   ASSERT_EQ(r.footprints.size(), 1u) << problems();
   EXPECT_EQ(r.footprints[0].method, "decomposition") << problems();
   EXPECT_EQ(count("FOOTPRINT_CLOSED_IN_PLAN"), 1u) << problems();
+}
 
-  options.inputs = {shared("kml-collada-korea-mago/sample-kml")};
+TEST(KmlRealDataThirdParty, PipelineEndToEndOnKmlFolders) {
+  PipelineOptions options;
+  PipelineResult r;
+  auto problems = [&] { return pipeline_problems(r); };
+  auto count = [&](const std::string& code) { return count_code(r, code); };
+  GROUNDPLAN_SKIP_IF_MISSING(shared_data("kml-collada-korea-mago/sample-kml"));
+  options.inputs = {shared_data("kml-collada-korea-mago/sample-kml")};
   r = run_pipeline(options);
   EXPECT_EQ(r.buildings_read, 3u) << "3 KMLs; the .dae beside them are not inputs of their own";
   EXPECT_EQ(r.footprints.size(), 3u) << problems();
@@ -298,7 +310,7 @@ TEST(KmlRealData, PipelineEndToEndOnKmzAndKmlFolders) {
   EXPECT_GT(area, 3 * 300.0);
   EXPECT_LT(area, 3 * 1500.0);
 
-  options.inputs = {shared("kml-collada-korea-mago/sample-kml-error-case")};
+  options.inputs = {shared_data("kml-collada-korea-mago/sample-kml-error-case")};
   r = run_pipeline(options);
   EXPECT_EQ(r.buildings_read, 3u) << "a building given up by the reader still counts as read (issue 8)";
   EXPECT_EQ(r.buildings_dropped, 2u);

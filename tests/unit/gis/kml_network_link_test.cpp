@@ -15,7 +15,6 @@
 #include <string>
 #include <vector>
 
-#include "test_config.h"
 
 #include "test_support.h"
 
@@ -25,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 
 
-const fs::path kKorea = fs::path(GROUNDPLAN_SHARED_DATA_DIR) / "kml-collada-korea-mago" / "sample-kml";
+const fs::path kKorea = test::shared_data("kml-collada-korea-mago/sample-kml");  // not redistributable: ThirdParty tests
 
 std::string network_link(const std::string& href, const std::string& id = "") {
   return "<NetworkLink" + (id.empty() ? std::string() : " id=\"" + id + "\"") +
@@ -74,7 +73,8 @@ std::vector<std::string> make_export(const test::TempDir& tmp) {
   return tiles;
 }
 
-TEST(KmlNetworkLink, CityDbExportGivesTheSamePlansAsItsTiles) {
+TEST(KmlNetworkLinkThirdParty, CityDbExportGivesTheSamePlansAsItsTiles) {
+  GROUNDPLAN_SKIP_IF_MISSING(kKorea);
   test::TempDir tmp("groundplan_netlink_test");
   const std::vector<std::string> tiles = make_export(tmp);
   const Read r = read((tmp.path / "master.kml").string());
@@ -95,7 +95,8 @@ TEST(KmlNetworkLink, CityDbExportGivesTheSamePlansAsItsTiles) {
   EXPECT_EQ(via_links.crs_name, listed.crs_name);
 }
 
-TEST(KmlNetworkLink, HostileLinksAreBoundedAndReported) {
+TEST(KmlNetworkLinkThirdParty, HostileLinksAreBoundedAndReported) {
+  GROUNDPLAN_SKIP_IF_MISSING(kKorea);
   test::TempDir tmp("groundplan_netlink_test");
   make_export(tmp);
   tmp.file("outside.kml", kml_doc(""));

@@ -22,19 +22,21 @@ namespace groundplan {
 namespace {
 
 struct Sample {
-  const char* path;  // relative to sample_data/ or ../shared/data
+  const char* path;  // relative to sample_data/, or as in ../shared/data (test::shared_data)
   bool shared;
   bool lod2;         // the area goal for --snap is stated for LoD2 samples
 };
 
 void PrintTo(const Sample& s, std::ostream* os) { *os << s.path; }
 
+std::string path_of(const Sample& s) { return s.shared ? test::shared_data(s.path) : test::sample_data(s.path); }
+
 const gis::PipelineResult& exact(const Sample& s) {
   static std::map<std::string, gis::PipelineResult> cache;
   auto it = cache.find(s.path);
   if (it == cache.end()) {
     gis::PipelineOptions o;
-    o.inputs = {s.shared ? test::shared_data(s.path) : test::sample_data(s.path)};
+    o.inputs = {path_of(s)};
     it = cache.emplace(s.path, gis::run_pipeline(o)).first;
   }
   return it->second;
@@ -82,7 +84,10 @@ double widest_vertex_clearance(const Ring& r) {
   return widest;
 }
 
-class LodOnRealData : public ::testing::TestWithParam<Sample> {};
+class LodOnRealData : public ::testing::TestWithParam<Sample> {
+ protected:
+  void SetUp() override { GROUNDPLAN_SKIP_IF_MISSING(path_of(GetParam())); }
+};
 
 TEST_P(LodOnRealData, EverySettingGivesValidDisjointPlans) {
   const gis::PipelineResult& r = exact(GetParam());
@@ -118,7 +123,8 @@ TEST_P(LodOnRealData, SnapOneMillimetreMeetsTheGoal) {
   const testing::LodMetrics after = testing::measure_plans(out.plans, 1e-3, 1e-3, 0);
   // Holes under 1e-3 m2 must be gone, except a hole that is no sliver at this tolerance: one with a
   // vertex farther than 1 mm from every edge not incident to it (the Berlin sample keeps one such hole,
-  // a wedge 3.6 mm wide and 0.48 m long: docs/level_of_detail.md). No such exception for slivers.
+  // a wedge 3.6 mm wide and 0.48 m long: lod_report in tests/bench/RESULTS.md). No such exception for
+  // slivers.
   std::size_t wide = 0;
   for (const GroundPlan& g : out.plans)
     for (const Ring& h : g.polygon.holes)
@@ -127,8 +133,8 @@ TEST_P(LodOnRealData, SnapOneMillimetreMeetsTheGoal) {
   RecordProperty("snap_small_holes_left", std::to_string(after.small_holes));
   EXPECT_EQ(after.close_pairs, 0u) << "before: " << before.close_pairs;
   // LoD1 tiles with millimetre coordinates hold wedge gaps (0 to 1 mm wide along a whole wall) whose
-  // closing is the join asked for; their area is reported in docs/level_of_detail.md, bounded here by
-  // what a 1 mm move of every plan's outline could add.
+  // closing is the join asked for; their area is reported by lod_report (tests/bench/RESULTS.md), bounded
+  // here by what a 1 mm move of every plan's outline could add.
   const double rel = std::fabs(after.area_m2 - before.area_m2) / before.area_m2;
   if (GetParam().lod2)
     EXPECT_LT(rel, 1e-6) << before.area_m2 << " -> " << after.area_m2;
@@ -159,12 +165,15 @@ INSTANTIATE_TEST_SUITE_P(
                       Sample{"plateau-niiza/53392547_bldg_6697_op2.gml", false, false},
                       Sample{"niedersachsen-lorup/LoD1_24065862_2_2021-01-25.gml", false, false},
                       Sample{"tum-main-entrance/TUM-Main-Entrance.gml", false, true},
-                      Sample{"citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml", true, true},
                       Sample{"citygml1-niedersachsen-lod1-4tiles", true, false},
                       Sample{"citygml2-plateau-japan-lod1", true, false},
-                      Sample{"citygml-citygml4j-samples/lod2_buildings_v3.gml", true, true},
-                      Sample{"citygml-ogc-spec-samples/plateau_53394517_bldg_6697_2_op_CityGML2.gml", true, true},
                       Sample{"kml-collada-macky-google", true, true}));
+// Samples that may not be redistributed (the third-party folder): skipped without it.
+INSTANTIATE_TEST_SUITE_P(
+    ThirdParty, LodOnRealData,
+    ::testing::Values(Sample{"citygml1-berlin-lod2-libcitygml/berlin_open_data_sample_data.citygml", true, true},
+                      Sample{"citygml-citygml4j-samples/lod2_buildings_v3.gml", true, true},
+                      Sample{"citygml-ogc-spec-samples/plateau_53394517_bldg_6697_2_op_CityGML2.gml", true, true}));
 
 }  // namespace
 }  // namespace groundplan

@@ -20,11 +20,11 @@ struct GeosComparison {
   double symdiff_area = 0;         // area of (ours XOR geos)
   std::size_t polygons_ours = 0, polygons_geos = 0;
   std::size_t holes_ours = 0, holes_geos = 0;
-  /// GEOS holes proven not to be holes of the input: triangles whose exact (rational) centroid lies
-  /// inside an input footprint. GEOS computes in floating point with snapping and, on real data,
+  /// GEOS holes proven not to be holes of the input: a point strictly inside them lies, exactly, inside an
+  /// input footprint. GEOS computes in floating point with snapping and, on real data,
   /// leaves such 1e-11 m² triangles where neighbours' walls meet one ulp apart.
   std::size_t holes_geos_artifacts = 0;
-  /// Our holes proven wrong the same way (triangle holes whose exact centroid an input footprint covers).
+  /// Our holes proven wrong the same way (a point strictly inside them is covered by an input footprint).
   std::size_t holes_ours_covered = 0;
   /// Where the counts differ or the symmetric difference is over 1e-10 of the area: whether the plans differ
   /// from GEOS's union only by material narrower than 1.5 snap pitches (`pitch_m` = groundplan::snap_pitch of
@@ -35,14 +35,38 @@ struct GeosComparison {
   bool differences_below_pitch = false;
   double pitch_m = 0;
   std::string first_difference_not_below_pitch;
+  /// Where our plans and GEOS's union differ, each piece of the difference decided exactly against the input
+  /// footprints (gis/geosref/adjudicate.h; only when GEOS's union is computed here, `reference` null): GEOS's
+  /// floating-point overlay keeps sub-µm² holes the input covers and closes holes that are real.
+  bool adjudicated = false;
+  std::size_t places_geos_wrong = 0;      // pieces where ours agrees with the input and GEOS does not
+  double largest_geos_wrong_m2 = 0;
+  std::size_t places_ours_wrong = 0;      // pieces where ours disagrees with the input, wider than 1.5 snap pitches
+  std::size_t places_ours_below_pitch = 0;// pieces where ours disagrees with the input, narrower (snap rounding)
+  std::size_t places_undecided = 0;       // pieces wider than the pitch with no point off every edge
+  double largest_ours_wrong_m2 = 0;
+  /// The first piece where ours is wrong (or undecided), for a person: where, how large, which buildings.
+  std::string first_ours_wrong;
+  /// GEOS holes that are real holes of the input which GEOS's union closed (our holes, decided exactly).
+  std::size_t holes_geos_dropped = 0;
   std::size_t invalid_ours = 0;    // plans that GEOSisValid rejects
   std::size_t overlapping_ours = 0;// pairs of our plans whose interiors overlap
+  std::size_t edge_touching_ours = 0;  // pairs of our plans whose boundaries share a segment (should be one plan)
   std::string first_invalid_reason;
-  /// The DESIGN.md criterion: symdiff <= rel_tol * area, same counts (GEOS's proven artifacts not
-  /// counted, none of ours proven wrong), all valid, no overlaps. Counts and areas that differ only by
-  /// features narrower than the snap pitch match too (below_pitch).
+  /// The DESIGN.md criterion: all valid, no overlaps, no two plans sharing an edge, none of our holes covered
+  /// by the input; when adjudicated, no piece of the difference where ours is wrong beyond the snap pitch (or
+  /// undecided); else the same counts (GEOS's proven artifacts and dropped holes accounted for) and
+  /// symdiff <= rel_tol * area.
+  /// Counts and areas that differ only by features narrower than the snap pitch match too (below_pitch).
   bool matches(double rel_tol = 1e-9) const;
-  bool counts_exact() const { return polygons_ours == polygons_geos && holes_ours == holes_geos - holes_geos_artifacts; }
+  bool counts_exact() const {
+    return polygons_ours == polygons_geos && holes_ours == holes_geos - holes_geos_artifacts + holes_geos_dropped;
+  }
+  /// MATCH, MATCH where GEOS differs and each place is decided in our favour, or MISMATCH.
+  enum class Verdict { Match, MatchGeosDiffers, Mismatch };
+  Verdict verdict(double rel_tol = 1e-9) const;
+  /// "MATCH", "MATCH: GEOS differs in N places, each decided in our favour: largest X m2" or "MISMATCH: ...".
+  std::string verdict_line() const;
   bool below_pitch() const { return differences_checked && differences_below_pitch; }
   std::string summary() const;     // one line for a person
 };

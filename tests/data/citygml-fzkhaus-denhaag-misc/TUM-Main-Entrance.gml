@@ -1,0 +1,1 @@
+../../../sample_data/tum-main-entrance/TUM-Main-Entrance.gml

@@ -1,0 +1,1 @@
+../../../sample_data/niedersachsen-lorup/LoD1_24065862_2_2021-01-25.gml

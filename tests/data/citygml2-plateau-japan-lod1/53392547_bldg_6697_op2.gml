@@ -1,0 +1,1 @@
+../../../sample_data/plateau-niiza/53392547_bldg_6697_op2.gml

@@ -1,0 +1,1 @@
+../../../sample_data/plateau-niiza/53395404_bldg_6697_op.gml
