@@ -81,13 +81,17 @@ int run_one_process(gis::PipelineOptions options, const Ogr2ogrArgs& ogr, const 
   std::unique_ptr<output::StreamedGpkg> streamed = stream_plans(ogr, options, id_chars);
   if (streamed)
     options.plan_feed = [&streamed](const PipelineResult& read) { return streamed->engage(read); };
+  // The problems layer asked for is written even when no input can be read.
+  options.unreadable_throws = !writes_problems(ogr);
   const auto result_ptr = std::make_shared<const PipelineResult>(groundplan::gis::run_pipeline(options, progress.sub(0, 1)));
   const PipelineResult& result = *result_ptr;
 
-  // Nothing usable (every building a problem, or no building at all): say so and fail, without
-  // writing an empty result that would look like success. The problems say why.
+  // Nothing usable (every building a problem, or no building at all): say so and fail, without writing an empty
+  // result that would look like success (only the problems layer, where asked for). The problems say why.
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
   if (result.footprints.empty()) {
-    say_nothing_usable(ogr, result.buildings_read, result.problems);
+    say_nothing_usable(ogr, result.buildings_read, result.problems,
+                       new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, options.threads));
     if (!stats_path.empty())
       write_stats(stats_path, result, 0, 0, seconds_since(t0), groundplan::gis::process_cpu_seconds() - cpu0, nullptr,
                   options.detail);
@@ -95,7 +99,6 @@ int run_one_process(gis::PipelineOptions options, const Ogr2ogrArgs& ogr, const 
   }
 
   // Hand the result to GDAL's ogr2ogr as an in-memory dataset of our driver.
-  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, options.threads);
   const WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {
     return new groundplan::driver::OGRGroundPlanDataSource(ds_name, result_ptr, id_chars, threads);

@@ -3,6 +3,8 @@
 
 #include <gdal.h>
 
+#include <algorithm>
+#include <cpl_string.h>
 #include <cstdio>
 #include <fstream>
 
@@ -90,7 +92,7 @@ std::string lod_summary(const groundplan::LodParams& p, const groundplan::LodSta
 
 }  // namespace
 
-void print_problems(const std::vector<groundplan::Problem>& problems) {
+void print_problems(const std::vector<groundplan::Problem>& problems, const std::string& problems_written) {
   constexpr std::size_t kShown = 20;
   for (std::size_t i = 0; i < problems.size() && i < kShown; ++i) {
     const auto& p = problems[i];
@@ -101,9 +103,16 @@ void print_problems(const std::vector<groundplan::Problem>& problems) {
       std::fprintf(stderr, "groundplan: %s: building %s: %s (%s)\n", p.file.c_str(), p.source_id.c_str(),
                    p.reason.c_str(), p.code.c_str());
   }
-  if (problems.size() > kShown)
-    std::fprintf(stderr, "groundplan: ... and %zu more problems: write the 'problems' layer to see them all\n",
-                 problems.size() - kShown);
+  if (problems.size() <= kShown) return;
+  std::size_t notes = 0;
+  for (std::size_t i = kShown; i < problems.size(); ++i) notes += problems[i].code == "NOTE";
+  const std::size_t defects = problems.size() - kShown - notes;
+  std::string more;
+  if (defects) more = std::to_string(defects) + (defects == 1 ? " more problem" : " more problems");
+  if (notes) more += (more.empty() ? "" : " and ") + std::to_string(notes) + (notes == 1 ? " more note" : " more notes");
+  std::fprintf(stderr, "groundplan: ... and %s: %s\n", more.c_str(),
+               problems_written.empty() ? "write the 'problems' layer to see them all"
+                                        : ("all are in the 'problems' layer of " + problems_written).c_str());
 }
 
 std::size_t count_defects(const std::vector<groundplan::Problem>& problems) {
@@ -112,17 +121,43 @@ std::size_t count_defects(const std::vector<groundplan::Problem>& problems) {
   return n;
 }
 
+std::string problems_and_notes(const std::vector<groundplan::Problem>& problems) {
+  const std::size_t defects = count_defects(problems), notes = problems.size() - defects;
+  std::string s = std::to_string(defects) + (defects == 1 ? " problem" : " problems");
+  if (notes) s += ", " + std::to_string(notes) + (notes == 1 ? " note" : " notes");
+  return s;
+}
+
+bool writes_problems(const Ogr2ogrArgs& ogr) {
+  return ogr.layer_named && std::any_of(ogr.layers.begin(), ogr.layers.end(),
+                                        [](const std::string& l) { return EQUAL(l.c_str(), "problems"); });
+}
+
 Progress terminal_progress(const Ogr2ogrArgs& ogr) {
   if (!ogr.progress || ogr.quiet) return {};
   return Progress([](double f, const char* msg) { return GDALTermProgress(f, msg, nullptr) != FALSE; });
 }
 
-void say_nothing_usable(const Ogr2ogrArgs& ogr, std::size_t buildings_read, const std::vector<Problem>& problems) {
-  if (!ogr.quiet) print_problems(problems);
-  std::fprintf(stderr, "groundplan: %s: nothing usable: %s; nothing written\n", ogr.src.c_str(),
-               buildings_read == 0
-                   ? "no building found"
-                   : (std::to_string(buildings_read) + " buildings read, none gave a footprint").c_str());
+void say_nothing_usable(const Ogr2ogrArgs& ogr, std::size_t buildings_read, const std::vector<Problem>& problems,
+                        GDALDataset* ds) {
+  bool wrote = false;
+  if (ds) {
+    GDALDatasetH h = GDALDataset::ToHandle(ds);
+    if (writes_problems(ogr)) {
+      std::vector<std::string> args = option_flags(ogr);
+      args.push_back("problems");
+      int usage_error = FALSE;
+      wrote = vector_translate(ogr.dst, h, args, false, &usage_error);
+      if (!wrote) std::fprintf(stderr, "groundplan: could not write the problems layer to %s\n", ogr.dst.c_str());
+    }
+    GDALClose(h);
+  }
+  if (!ogr.quiet) print_problems(problems, wrote ? ogr.dst : std::string());
+  const std::string why = buildings_read == 0
+                              ? "no building found"
+                              : std::to_string(buildings_read) + " buildings read, none gave a footprint";
+  std::fprintf(stderr, "groundplan: %s: nothing usable: %s; %s\n", ogr.src.c_str(), why.c_str(),
+               wrote ? ("only the 'problems' layer written, to " + ogr.dst).c_str() : "nothing written");
 }
 
 void print_summary(const PipelineResult& result, const Ogr2ogrArgs& ogr, const LodParams& detail, double total_s,
@@ -131,8 +166,8 @@ void print_summary(const PipelineResult& result, const Ogr2ogrArgs& ogr, const L
   const std::size_t holes = count_holes(result);
   std::printf("groundplan: read %zu buildings from %s (CRS %s)\n", result.buildings_read, ogr.src.c_str(),
               result.crs_name.empty() ? "unknown" : result.crs_name.c_str());
-  std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %zu problems\n",
-              result.footprints.size(), result.plans.size(), holes, count_defects(result.problems));
+  std::printf("groundplan: %zu footprints -> %zu ground plans with %zu holes; %s\n", result.footprints.size(),
+              result.plans.size(), holes, problems_and_notes(result.problems).c_str());
   std::printf(
       "groundplan: wrote %s in %.2f s (read %.2f s, footprints %.2f s, blocks %.2f s (%zu, %s), union %.2f s, "
       "write %.2f s)\n",
@@ -142,7 +177,7 @@ void print_summary(const PipelineResult& result, const Ogr2ogrArgs& ogr, const L
   if (detail.any())
     std::printf("groundplan: level of detail (%.2f s): %s\n", result.timings.lod_s,
                 lod_summary(detail, result.lod_stats).c_str());
-  print_problems(result.problems);
+  print_problems(result.problems, writes_problems(ogr) ? ogr.dst : std::string());
 }
 
 bool write_stats(const std::string& path, const PipelineResult& result, double write_s, double index_s, double total_s,
@@ -152,7 +187,8 @@ bool write_stats(const std::string& path, const PipelineResult& result, double w
   j["counts"] = {{"buildings", result.buildings_read}, {"footprints", result.footprints.size()},
                  {"dropped", result.buildings_dropped},  {"blocks", result.blocks},
                  {"ground_plans", result.plans.size()},
-                 {"holes", count_holes(result)},          {"problems", count_defects(result.problems)}};
+                 {"holes", count_holes(result)},          {"problems", count_defects(result.problems)},
+                 {"notes", result.problems.size() - count_defects(result.problems)}};
   j["timings_s"] = {{"read", result.timings.read_s},     {"footprints", result.timings.footprints_s},
                     {"blocks", result.timings.blocks_s}, {"union", result.timings.union_s},
                     {"level_of_detail", result.timings.lod_s}, {"write", write_s},
@@ -187,7 +223,8 @@ bool write_tiled_stats(const std::string& stats_path, const groundplan::gis::Til
   const groundplan::gis::TileStats& t = r.tiles;
   nlohmann::json j;
   j["counts"] = {{"buildings", r.buildings_read}, {"footprints", r.footprints}, {"dropped", r.buildings_dropped},
-                 {"blocks", r.blocks}, {"ground_plans", plans}, {"problems", count_defects(r.problems)}};
+                 {"blocks", r.blocks}, {"ground_plans", plans}, {"problems", count_defects(r.problems)},
+                 {"notes", r.problems.size() - count_defects(r.problems)}};
   j["timings_s"] = {{"read", r.timings.read_s}, {"footprints", r.timings.footprints_s}, {"blocks", r.timings.blocks_s},
                     {"union", r.timings.union_s}, {"write", write_s}, {"spatial_index", index_s},
                     {"total", total_s}, {"cpu", cpu_s}};
@@ -228,12 +265,12 @@ void print_tiled_summary(const groundplan::gis::TiledResult& r, const Ogr2ogrArg
               r.crs_name.empty() ? "unknown" : r.crs_name.c_str(), t.tiles,
               r.ranks.size() > 1 ? (" on " + std::to_string(r.ranks.size()) + " MPI ranks").c_str() : "");
   std::printf("groundplan: %zu footprints -> %zu ground plans (%zu final at once, %zu from %zu seam plans of "
-              "%zu footprints); %zu problems\n",
+              "%zu footprints); %s\n",
               r.footprints, plans, t.final_plans, t.reduced_plans, t.seam_plans, t.seam_footprints,
-              count_defects(r.problems));
+              problems_and_notes(r.problems).c_str());
   std::printf("groundplan: wrote %s in %.2f s (map %.2f s, reduce %.2f s, write %.2f s)\n", dst.c_str(), total_s,
               t.map_s, t.reduce_s, write_s);
-  print_problems(r.problems);
+  print_problems(r.problems, writes_problems(ogr) ? dst : std::string());
 }
 
 }  // namespace groundplan::cli

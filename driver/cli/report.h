@@ -17,18 +17,29 @@
 
 namespace groundplan::cli {
 
-/// The first problems on stderr, and how many more there are.
-void print_problems(const std::vector<Problem>& problems);
+/// The first problems and notes on stderr, and how many of each are not shown (counted as the summary counts:
+/// problems apart from notes). `problems_written`: the dataset whose problems layer holds them all; empty when no
+/// problems layer was written.
+void print_problems(const std::vector<Problem>& problems, const std::string& problems_written = {});
 
 /// Problems proper, without notes (a CRS guess is worth saying but is no defect).
 std::size_t count_defects(const std::vector<Problem>& problems);
 
+/// "4 problems" or "4 problems, 36 notes": the summary's count, notes apart.
+std::string problems_and_notes(const std::vector<Problem>& problems);
+
+/// Whether the output holds a problems layer (named among the layers written).
+bool writes_problems(const Ogr2ogrArgs& ogr);
+
 /// -progress: GDAL's progress bar on the terminal, unless -q; otherwise none.
 Progress terminal_progress(const Ogr2ogrArgs& ogr);
 
-/// A run without a footprint (every building a problem, or none at all): its problems (unless -q) and why nothing is
-/// written.
-void say_nothing_usable(const Ogr2ogrArgs& ogr, std::size_t buildings_read, const std::vector<Problem>& problems);
+/// A run without a footprint (every building a problem, or none at all): the problems layer alone is written where it
+/// was asked for (through `ds`, taken and closed here; null: nothing is written, as a rank of a run over ranks does),
+/// no empty ground plans that would look like a result; the problems (unless -q) and why nothing else is written go
+/// to stderr. The run fails all the same.
+void say_nothing_usable(const Ogr2ogrArgs& ogr, std::size_t buildings_read, const std::vector<Problem>& problems,
+                        GDALDataset* ds = nullptr);
 
 /// What the one-process run says when it has written (unless -q): counts, timings, the level of detail, problems.
 void print_summary(const gis::PipelineResult& result, const Ogr2ogrArgs& ogr, const LodParams& detail, double total_s,

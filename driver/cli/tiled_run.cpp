@@ -111,19 +111,29 @@ int run_tiled(const PipelineOptions& options, const Ogr2ogrArgs& ogr_in, const s
 #else
   auto finish = [](int rc) { return rc; };
 #endif
-  if (!result) result = groundplan::gis::run_pipeline_tiled(options, progress);
+  if (!result) {
+    // One process: the problems layer asked for is written even when no input can be read (over ranks the first
+    // fault stops every rank).
+    PipelineOptions own = options;
+    own.unreadable_throws = !writes_problems(ogr);
+    result = groundplan::gis::run_pipeline_tiled(own, progress);
+  }
   const groundplan::gis::TiledResult& r = *result;
   auto stats = [&](double write_s, double index_s, const WriteOutcome* written) {
     return write_tiled_stats(stats_path, r, r.plan_count(), write_s, index_s, written, seconds_since(t0),
                              groundplan::gis::process_cpu_seconds() - cpu0);
   };
+  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
+  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
   if (r.footprints == 0) {
-    say_nothing_usable(ogr, r.buildings_read, r.problems);
+    // Over ranks the output is staged and not committed on failure: nothing is written there.
+    say_nothing_usable(ogr, r.buildings_read, r.problems,
+                       rank_count(ranks) > 1
+                           ? nullptr
+                           : new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, options.threads));
     stats(0, 0, nullptr);
     return finish(1);
   }
-  const std::string ds_name = std::string(groundplan::driver::kPrefix) + ogr.src;
-  const std::size_t id_chars = writes_dbf(ogr) ? 254 : 0;
   auto* ds = new groundplan::driver::OGRGroundPlanDataSource(ds_name, result, id_chars, options.threads);
   // Plans are read back from the run's spill by position: datasets side by side may read it at once.
   WriteOutcome w = write_output(ds, ogr, options.threads, [&](int threads) {

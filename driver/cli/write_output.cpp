@@ -163,7 +163,7 @@ WriteOutcome write_output(groundplan::driver::OGRGroundPlanDataSource* ds, const
     members_note = std::to_string(ds->id_lists_cut()) +
                    " plans list more building ids than a DBF field holds (254 characters): their building_ids end "
                    "in '...(+N)'; the full lists are in " +
-                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id)";
+                   (std::filesystem::path(dir) / (name + ".dbf")).string() + " (gp_id, fp_id, source_id, bldg_id)";
   }
   GDALClose(src_h);
   w.ok = write_ok;

@@ -62,8 +62,7 @@ StreamedGpkg::~StreamedGpkg() {
 PlanFeed* StreamedGpkg::engage(const gis::PipelineResult& read) {
   fps_ = read.footprints.data();
   n_fps_ = read.footprints.size();
-  has_srs_ = !read.crs_wkt.empty() && srs_.importFromWkt(read.crs_wkt.c_str()) == OGRERR_NONE;
-  if (has_srs_) srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  driver::detail::layer_srs(read.crs_wkt, srs_);
   return this;
 }
 
@@ -137,7 +136,7 @@ bool StreamedGpkg::write_one(std::size_t k, std::size_t first, std::size_t last,
     const std::vector<std::size_t>* first_of = &first_;
     const std::vector<std::vector<GroundPlan>>* by_block = &by_block_;
     auto layer = driver::detail::plans_layer(
-        has_srs_ ? &srs_ : nullptr, last,
+        &srs_, last,
         [first_of, by_block, blocks_seen](std::size_t i) -> const GroundPlan& {
           // The last block of the prefix seen whose first plan is at or before i (empty blocks share a first plan).
           const auto it = std::upper_bound(first_of->begin(), first_of->begin() + static_cast<std::ptrdiff_t>(blocks_seen) + 1, i);

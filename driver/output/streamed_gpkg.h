@@ -72,7 +72,6 @@ class StreamedGpkg final : public PlanFeed {
   Setup setup_;
   std::string table_;
   OGRSpatialReference srs_;
-  bool has_srs_ = false;
   const Footprint* fps_ = nullptr;
   std::size_t n_fps_ = 0;
   bool slice0_late_ = false;  // slice 0 carries other layers: written by finish()

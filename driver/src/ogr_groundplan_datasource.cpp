@@ -84,36 +84,23 @@ std::unique_ptr<OGRGroundPlanLayer> detail::plans_layer(const OGRSpatialReferenc
       [plan_at = std::move(plan_at), fps, n_fps, max_id_list_chars](OGRFeatureDefn* defn, std::size_t i) {
         const GroundPlan& gp = plan_at(i);
         auto* f = new OGRFeature(defn);
-        std::string ids;
+        PlanIds ids;
         double zmin = 0, zmax = 0;
         bool first = true;
         for (std::uint32_t m : gp.members) {
           if (m >= n_fps) continue;
-          if (!ids.empty()) ids += ',';
-          ids += fps[m].source_id;
+          ids.add(fps[m]);
           zmin = first ? fps[m].min_z : std::min(zmin, fps[m].min_z);
           zmax = first ? fps[m].max_z : std::max(zmax, fps[m].max_z);
           first = false;
         }
-        f->SetField(0, static_cast<GIntBig>(i + 1));
-        f->SetField(1, static_cast<int>(gp.members.size()));
-        f->SetField(2, gp.area_m2);
-        if (!first) {
-          f->SetField(3, zmin);
-          f->SetField(4, zmax);
-        }
-        f->SetField(5, cut_id_list(ids, gp.members.size(), max_id_list_chars).c_str());
+        set_plan_fields(f, static_cast<GIntBig>(i + 1), gp.members.size(), gp.area_m2, !first, zmin, zmax, ids,
+                        max_id_list_chars);
         f->SetGeometryDirectly(to_ogr_polygon(gp.polygon));
         return f;
       },
       std::move(extent), threads);
-  // DBF field names hold 10 characters: say what GDAL would otherwise launder with a warning.
-  add_field(layer->defn(), "gp_id", OFTInteger64);
-  add_field(layer->defn(), "n_parts", OFTInteger);
-  add_field(layer->defn(), "area_m2", OFTReal);
-  add_field(layer->defn(), "min_z", OFTReal);
-  add_field(layer->defn(), "max_z", OFTReal);
-  add_field(layer->defn(), max_id_list_chars > 0 ? "bldg_ids" : "building_ids", OFTString);
+  add_plan_fields(layer->defn(), max_id_list_chars > 0);
   return layer;
 }
 
@@ -141,11 +128,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
     : result_(std::move(result)) {
   SetDescription(description.c_str());
   const gis::PipelineResult& r = *result_;
-  const OGRSpatialReference* srs = nullptr;
-  if (!r.crs_wkt.empty() && srs_.importFromWkt(r.crs_wkt.c_str()) == OGRERR_NONE) {
-    srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    srs = &srs_;
-  }
+  const OGRSpatialReference* srs = detail::layer_srs(r.crs_wkt, srs_);
   const gis::PipelineResult* res = result_.get();  // the layers' makers share it with this dataset
   const auto& fps = r.footprints;
 
@@ -154,13 +137,13 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   const bool dbf = max_id_list_chars > 0;
   plan_of_.assign(fps.size(), 0);
   for (std::size_t i = 0; i < r.plans.size(); ++i) {
-    std::size_t chars = 0, n = 0;
+    detail::PlanIds ids;
     for (std::uint32_t m : r.plans[i].members) {
       if (m >= fps.size()) continue;
       plan_of_[m] = static_cast<GIntBig>(i + 1);
-      chars += (n++ ? 1 : 0) + fps[m].source_id.size();
+      if (dbf) ids.add(fps[m]);
     }
-    id_lists_cut_ += dbf && chars > max_id_list_chars;
+    id_lists_cut_ += ids.cut(max_id_list_chars);
   }
   const GIntBig* plan_of = plan_of_.data();
 
@@ -188,6 +171,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
         if (plan_of[i]) f->SetField(4, plan_of[i]);
         f->SetField(5, fp.min_z);
         f->SetField(6, fp.max_z);
+        f->SetField(7, building_id_of(fp).c_str());
         auto* mp = new OGRMultiPolygon();
         for (const Polygon& p : fp.polygons) mp->addGeometryDirectly(to_ogr_polygon(p));
         f->SetGeometryDirectly(mp);
@@ -207,6 +191,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
   add_field(footprints->defn(), "gp_id", OFTInteger64);
   add_field(footprints->defn(), "min_z", OFTReal);
   add_field(footprints->defn(), "max_z", OFTReal);
+  add_field(footprints->defn(), dbf ? "bldg_id" : "building_id", OFTString);
 
   auto problems = detail::problems_layer(&res->problems, threads);
 
@@ -223,15 +208,13 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
       [res, rows](OGRFeatureDefn* defn, std::size_t i) {
         const Member& m = (*rows)[i];
         auto* f = new OGRFeature(defn);
-        f->SetField(0, static_cast<GIntBig>(m.plan) + 1);
-        f->SetField(1, static_cast<GIntBig>(m.footprint) + 1);
-        f->SetField(2, res->footprints[m.footprint].source_id.c_str());
+        const Footprint& fp = res->footprints[m.footprint];
+        detail::set_member_fields(f, static_cast<GIntBig>(m.plan) + 1, static_cast<GIntBig>(m.footprint) + 1,
+                                  fp.source_id, building_id_of(fp));
         return f;
       },
       OGRGroundPlanLayer::Extent{}, threads);
-  add_field(members->defn(), "gp_id", OFTInteger64);
-  add_field(members->defn(), "fp_id", OFTInteger64);
-  add_field(members->defn(), "source_id", OFTString);
+  detail::add_member_fields(members->defn(), dbf);
 
   layers_.push_back(std::move(plans));
   layers_.push_back(std::move(footprints));

@@ -17,14 +17,9 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
                                                  std::shared_ptr<const gis::TiledResult> tiled,
                                                  std::size_t max_id_list_chars, int threads)
     : tiled_(std::move(tiled)) {
-  using detail::add_field;
   SetDescription(description.c_str());
   const gis::TiledResult* res = tiled_.get();
-  const OGRSpatialReference* srs = nullptr;
-  if (!res->crs_wkt.empty() && srs_.importFromWkt(res->crs_wkt.c_str()) == OGRERR_NONE) {
-    srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    srs = &srs_;
-  }
+  const OGRSpatialReference* srs = detail::layer_srs(res->crs_wkt, srs_);
   const bool dbf = max_id_list_chars > 0;
   cut_flags_ = std::make_shared<std::vector<std::uint8_t>>(res->plan_count(), 0);
   std::vector<std::uint8_t>* cut = cut_flags_.get();
@@ -33,22 +28,13 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
       [res, cut, max_id_list_chars](OGRFeatureDefn* defn, std::size_t i) {
         const gis::StoredPlan sp = res->plan(i);
         auto* f = new OGRFeature(defn);
-        std::string ids;
-        for (const std::string& id : sp.member_ids) {
-          if (!ids.empty()) ids += ',';
-          ids += id;
-        }
-        if (max_id_list_chars && ids.size() > max_id_list_chars) (*cut)[i] = 1;
+        detail::PlanIds ids;
+        for (std::size_t k = 0; k < sp.member_ids.size(); ++k) ids.add(sp.member_ids[k], sp.member_buildings[k]);
+        if (ids.cut(max_id_list_chars)) (*cut)[i] = 1;
         const auto gp_id = static_cast<GIntBig>(res->plan_number(i) + 1);
         f->SetFID(gp_id);
-        f->SetField(0, gp_id);
-        f->SetField(1, static_cast<int>(sp.plan.members.size()));
-        f->SetField(2, sp.plan.area_m2);
-        if (!sp.member_ids.empty()) {
-          f->SetField(3, sp.min_z);
-          f->SetField(4, sp.max_z);
-        }
-        f->SetField(5, detail::cut_id_list(ids, sp.plan.members.size(), max_id_list_chars).c_str());
+        detail::set_plan_fields(f, gp_id, sp.plan.members.size(), sp.plan.area_m2, !sp.member_ids.empty(), sp.min_z,
+                                sp.max_z, ids, max_id_list_chars);
         f->SetGeometryDirectly(detail::to_ogr_polygon(sp.plan.polygon));
         return f;
       },
@@ -63,12 +49,7 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
         return e;
       },
       threads);
-  add_field(plans->defn(), "gp_id", OFTInteger64);
-  add_field(plans->defn(), "n_parts", OFTInteger);
-  add_field(plans->defn(), "area_m2", OFTReal);
-  add_field(plans->defn(), "min_z", OFTReal);
-  add_field(plans->defn(), "max_z", OFTReal);
-  add_field(plans->defn(), dbf ? "bldg_ids" : "building_ids", OFTString);
+  detail::add_plan_fields(plans->defn(), dbf);
 
   auto problems = detail::problems_layer(&res->problems, threads);
 
@@ -85,15 +66,12 @@ OGRGroundPlanDataSource::OGRGroundPlanDataSource(const std::string& description,
         const std::size_t k = r - static_cast<std::size_t>(res->members_before(lo));
         auto* f = new OGRFeature(defn);
         f->SetFID(static_cast<GIntBig>(res->row_number(lo) + k) + 1);
-        f->SetField(0, static_cast<GIntBig>(res->plan_number(lo)) + 1);
-        f->SetField(1, static_cast<GIntBig>(sp.plan.members[k]) + 1);
-        f->SetField(2, sp.member_ids[k].c_str());
+        detail::set_member_fields(f, static_cast<GIntBig>(res->plan_number(lo)) + 1,
+                                  static_cast<GIntBig>(sp.plan.members[k]) + 1, sp.member_ids[k], sp.member_buildings[k]);
         return f;
       },
       OGRGroundPlanLayer::Extent{}, threads);
-  add_field(members->defn(), "gp_id", OFTInteger64);
-  add_field(members->defn(), "fp_id", OFTInteger64);
-  add_field(members->defn(), "source_id", OFTString);
+  detail::add_member_fields(members->defn(), dbf);
 
   layers_.push_back(std::move(plans));
   layers_.push_back(std::move(problems));

@@ -17,6 +17,7 @@
 #include <list>
 #include <map>
 #include <mutex>
+#include <cstring>
 #include <system_error>
 
 namespace groundplan::driver {
@@ -34,26 +35,36 @@ bool file_stamp(const fs::path& p, std::string& out) {
   return true;
 }
 
-/// Every regular file under `folder` with its stamp, sorted; false when the folder cannot be listed whole or
-/// holds more than kMaxTrackedFiles files.
-bool folder_stamps(const fs::path& folder, std::string& out) {
-  std::vector<std::string> lines;
-  std::error_code ec;
-  fs::recursive_directory_iterator it(folder, fs::directory_options::none, ec), end;
-  if (ec) return false;
-  for (; it != end; it.increment(ec)) {
-    if (ec) return false;
-    std::error_code type_ec;
-    if (!it->is_regular_file(type_ec)) continue;
-    if (lines.size() == kMaxTrackedFiles) return false;
-    std::string line = it->path().lexically_relative(folder).string() + '\t';
-    if (!file_stamp(it->path(), line)) return false;
-    lines.push_back(std::move(line));
+/// The file a reader's path lives in: the path itself, or for a /vsizip/ or /vsigzip/ path (a KMZ's KML, a
+/// model inside a zip) the archive holding it; empty when there is no local file (another /vsi file system).
+fs::path local_file_of(const std::string& path) {
+  std::string p = path;
+  for (const char* prefix : {"/vsizip/", "/vsigzip/"})
+    if (p.rfind(prefix, 0) == 0) {
+      p.erase(0, std::strlen(prefix));
+      if (!p.empty() && p.front() == '{' && p.find('}') != std::string::npos) p.erase(0, 1), p.erase(p.find('}'), 1);
+      for (fs::path f(p); !f.empty() && f != f.parent_path(); f = f.parent_path()) {
+        std::error_code ec;
+        if (fs::is_regular_file(f, ec)) return f;
+      }
+      return {};
+    }
+  if (p.rfind("/vsi", 0) == 0) return {};
+  return fs::path(p);
+}
+
+/// "path\tstamp\n" for each of `files` (the files a result was read from), in order; a file that is gone is
+/// "missing". A result is valid while this is what it was when the result was made.
+std::string stamps_of(const std::vector<std::string>& files) {
+  std::string out;
+  for (const std::string& f : files) {
+    const fs::path local = local_file_of(f);
+    if (local.empty()) continue;
+    out += local.string() + '\t';
+    if (!file_stamp(local, out)) out += "missing";
+    out += '\n';
   }
-  if (ec) return false;
-  std::sort(lines.begin(), lines.end());
-  for (const std::string& l : lines) out += l + '\n';
-  return true;
+  return out;
 }
 
 std::size_t config_size(const char* name, std::size_t fallback) {
@@ -74,11 +85,19 @@ class ResultCache {
     auto found = slots_.find(key);
     if (found != slots_.end()) {
       if (SharedResult live = found->second.live.lock()) {
-        touch(key, live);
-        lock.unlock();  // no call out (an error handler may be Python, waiting for its GIL) under the lock
-        CPLDebug("GroundPlan", "cached result for %s", what.c_str());
-        return live;
+        if (stamps_of(live->files_read) == found->second.stamps) {
+          touch(key, live);
+          lock.unlock();  // no call out (an error handler may be Python, waiting for its GIL) under the lock
+          CPLDebug("GroundPlan", "cached result for %s", what.c_str());
+          return live;
+        }
+        // A file it was read from changed (a linked model, a buffer): computed again. Open datasets keep theirs.
+        kept_.remove_if([&](const Kept& k) { return k.key == key; });
+        slots_.erase(found);
+        found = slots_.end();
       }
+    }
+    if (found != slots_.end()) {
       if (found->second.pending.valid()) {
         std::shared_future<SharedResult> pending = found->second.pending;
         lock.unlock();
@@ -90,8 +109,9 @@ class ResultCache {
     slots_[key].pending = promise.get_future().share();
     lock.unlock();
     SharedResult result;
+    std::string stamps;
     try {
-      result = produce(key, what, compute);
+      result = produce(key, what, compute, stamps);
     } catch (...) {
       lock.lock();
       slots_.erase(key);
@@ -102,6 +122,7 @@ class ResultCache {
     lock.lock();
     Slot& slot = slots_[key];
     slot.live = result;
+    slot.stamps = std::move(stamps);
     slot.pending = {};
     touch(key, result);
     lock.unlock();
@@ -117,24 +138,32 @@ class ResultCache {
 
   static std::size_t runs() { return runs_.load(); }
 
-  /// From GROUNDPLAN_CACHE_DIR when it holds `key`, else computed (and stored there when it is set).
+  /// From GROUNDPLAN_CACHE_DIR when it holds `key` and the files it was read from are as they were then, else
+  /// computed (and stored there when it is set). `stamps`: those files' stamps (stamps_of).
   static SharedResult produce(const std::string& key, const std::string& what,
-                              const std::function<gis::PipelineResult()>& compute) {
+                              const std::function<gis::PipelineResult()>& compute, std::string& stamps) {
     const std::string dir = result_store_dir();
     if (!dir.empty()) {
-      if (std::optional<gis::PipelineResult> stored = load_result(dir, key)) {
-        CPLDebug("GroundPlan", "result for %s read from %s", what.c_str(), dir.c_str());
-        return std::make_shared<const gis::PipelineResult>(std::move(*stored));
+      std::string stored_stamps;
+      if (std::optional<gis::PipelineResult> stored = load_result(dir, key, &stored_stamps)) {
+        stamps = stamps_of(stored->files_read);
+        if (stamps == stored_stamps) {
+          CPLDebug("GroundPlan", "result for %s read from %s", what.c_str(), dir.c_str());
+          return std::make_shared<const gis::PipelineResult>(std::move(*stored));
+        }
+        CPLDebug("GroundPlan", "result for %s in %s was read from files changed since: ignored", what.c_str(), dir.c_str());
       }
     }
     SharedResult result = run(what, compute);
-    if (!dir.empty()) store_result(dir, key, *result);
+    stamps = stamps_of(result->files_read);
+    if (!dir.empty()) store_result(dir, key, *result, stamps);
     return result;
   }
 
  private:
   struct Slot {
     std::weak_ptr<const gis::PipelineResult> live;
+    std::string stamps;  // of the files the result was read from, when it was made (stamps_of)
     std::shared_future<SharedResult> pending;
   };
   struct Kept {
@@ -205,10 +234,17 @@ std::string result_cache_key(const std::vector<std::string>& inputs, char** open
     std::error_code ec;
     const fs::path canonical = fs::canonical(input, ec);
     if (ec) return {};  // not a local file or folder: a database, a URL ...
-    const bool folder = fs::is_directory(canonical, ec);
-    if (ec) return {};
     key += "input\t" + canonical.string() + '\n';
-    if (!folder_stamps(folder ? canonical : canonical.parent_path(), key)) return {};
+    // The files it names (a folder: its input files; another file written beside them is none of them) as they
+    // are now; what they link is checked against the result's files_read when the result is reused.
+    std::vector<std::string> files;
+    try {
+      files = gis::input_files({canonical.string()});
+    } catch (const std::exception&) {
+      return {};  // the run says why
+    }
+    if (files.size() > kMaxTrackedFiles) return {};
+    key += stamps_of(files);
   }
   std::vector<std::string> options;
   for (CSLConstList o = open_options; o && *o; ++o) {

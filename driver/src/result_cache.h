@@ -6,10 +6,14 @@
 // options gets the result the first open computed.
 //
 // The key: every input's canonical path and the size, modification and change times and inode of every file
-// under its folder (a file input: its own folder, where external glTF buffers, COLLADA models of a KML and
-// shapefile sidecars live), plus every open option except NUM_THREADS (the result is the same with any
-// thread count). An input that is not a local file or folder (a database connection, /vsicurl/ ...) or a
-// folder of more than kMaxTrackedFiles files is not cached: every open computes.
+// it names (a file; a folder: its input files, gis::input_files), plus every open option except NUM_THREADS
+// (the result is the same with any thread count). A result is reused only while the files the readers opened
+// for it (PipelineResult::files_read: the inputs and what they link, a KML's COLLADA models and NetworkLinks, a
+// glTF's buffers, an OGR source's sidecars; also those looked for and missing) have the stamps they had when it
+// was made: a changed linked file computes again, while a file written beside the input that no reader opens
+// (the output GeoPackage, a log) changes nothing. An input that is not a local file or folder (a database
+// connection, /vsicurl/ ...) or a folder of more than kMaxTrackedFiles input files is not cached: every open
+// computes.
 //
 // Bounds: a result stays while any dataset holds it (open datasets share it, at no cost), and the last
 // GROUNDPLAN_CACHE_ENTRIES results (default 4) closed datasets left are kept while their estimated size is
@@ -34,7 +38,7 @@ namespace groundplan::driver {
 
 using SharedResult = std::shared_ptr<const gis::PipelineResult>;
 
-/// Files beyond this many under one input's folder: the input is not cached (its key would take too long).
+/// Input files beyond this many in one input folder: the input is not cached (its key would take too long).
 inline constexpr std::size_t kMaxTrackedFiles = 20000;
 
 /// The key of an open of `inputs` with the CSL open options `open_options`; empty when not cacheable.

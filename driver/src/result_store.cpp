@@ -22,12 +22,12 @@ namespace {
 namespace fs = std::filesystem;
 
 // A field added to these types must be stored too: these fail to compile until the writer and reader follow.
-static_assert(sizeof(Footprint) == sizeof(std::vector<Polygon>) + 3 * sizeof(std::string) + 2 * sizeof(double));
+static_assert(sizeof(Footprint) == sizeof(std::vector<Polygon>) + 4 * sizeof(std::string) + 2 * sizeof(double));
 static_assert(sizeof(GroundPlan) == sizeof(Polygon) + sizeof(std::vector<std::uint32_t>) + sizeof(double));
 static_assert(sizeof(Problem) == 5 * sizeof(std::string));
 static_assert(std::is_trivially_copyable_v<Point2> && sizeof(Point2) == 2 * sizeof(double));
 
-constexpr char kMagic[8] = {'G', 'P', 'R', 'E', 'S', 'U', '0', '1'};
+constexpr char kMagic[8] = {'G', 'P', 'R', 'E', 'S', 'U', '0', '2'};  // 02: Footprint::parent_id, files read
 
 /// 64-bit FNV-1a: names the file only; the key inside decides.
 std::uint64_t fnv1a(const std::string& s) {
@@ -133,7 +133,7 @@ std::string result_store_dir() {
   return dir ? dir : "";
 }
 
-std::optional<gis::PipelineResult> load_result(const std::string& dir, const std::string& key) {
+std::optional<gis::PipelineResult> load_result(const std::string& dir, const std::string& key, std::string* stamps) {
   const fs::path path = file_for(dir, key);
   std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
@@ -147,7 +147,10 @@ std::optional<gis::PipelineResult> load_result(const std::string& dir, const std
     CPLDebug("GroundPlan", "%s holds another key: ignored", path.c_str());
     return std::nullopt;
   }
+  const std::string stored_stamps = r.str();
   gis::PipelineResult res;
+  res.files_read.resize(r.count(1));
+  for (std::string& f : res.files_read) f = r.str();
   res.footprints.resize(r.count(1));
   for (Footprint& f : res.footprints) {
     f.polygons.resize(r.count(1));
@@ -157,6 +160,7 @@ std::optional<gis::PipelineResult> load_result(const std::string& dir, const std
     f.method = r.str();
     f.min_z = r.pod<double>();
     f.max_z = r.pod<double>();
+    f.parent_id = r.str();
   }
   res.plans.resize(r.count(1));
   for (GroundPlan& g : res.plans) {
@@ -182,10 +186,12 @@ std::optional<gis::PipelineResult> load_result(const std::string& dir, const std
     CPLDebug("GroundPlan", "%s is cut or damaged: ignored", path.c_str());
     return std::nullopt;
   }
+  if (stamps) *stamps = stored_stamps;
   return res;
 }
 
-bool store_result(const std::string& dir, const std::string& key, const gis::PipelineResult& res) {
+bool store_result(const std::string& dir, const std::string& key, const gis::PipelineResult& res,
+                  const std::string& stamps) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   const fs::path path = file_for(dir, key);
@@ -201,6 +207,9 @@ bool store_result(const std::string& dir, const std::string& key, const gis::Pip
     Writer w(out);
     out.write(kMagic, sizeof kMagic);
     w.str(key);
+    w.str(stamps);
+    w.pod<std::uint64_t>(res.files_read.size());
+    for (const std::string& f : res.files_read) w.str(f);
     w.pod<std::uint64_t>(res.footprints.size());
     for (const Footprint& f : res.footprints) {
       w.pod<std::uint64_t>(f.polygons.size());
@@ -210,6 +219,7 @@ bool store_result(const std::string& dir, const std::string& key, const gis::Pip
       w.str(f.method);
       w.pod(f.min_z);
       w.pod(f.max_z);
+      w.str(f.parent_id);
     }
     w.pod<std::uint64_t>(res.plans.size());
     for (const GroundPlan& g : res.plans) {

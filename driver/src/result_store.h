@@ -8,7 +8,8 @@
 //
 // The key (result_cache.h) holds the inputs' sizes, times and inodes, so a changed input is a new key:
 // the old file is never read again (nothing removes it; clear the folder to reclaim the space). It also
-// holds this build's identity, so results of another build of the pipeline are never used.
+// holds this build's identity, so results of another build of the pipeline are never used. The files the
+// inputs link (models, buffers) are stored with their stamps beside the key: a changed one makes it a miss.
 //
 // Stored: what the driver's layers show (footprints, plans, problems, the working CRS, the counts of
 // buildings read and dropped, blocks, backend); the timings and reading statistics are not (they describe
@@ -24,9 +25,13 @@ namespace groundplan::driver {
 std::string result_store_dir();
 
 /// The result stored for `key` in `dir`; nothing when there is none, it holds another key or cannot be read.
-std::optional<gis::PipelineResult> load_result(const std::string& dir, const std::string& key);
+/// `stamps` gets the stamps of the files it was read from, as stored with it.
+std::optional<gis::PipelineResult> load_result(const std::string& dir, const std::string& key, std::string* stamps);
 
-/// Stores `result` for `key` in `dir` (created if needed); false, with a CPLDebug line saying why, on failure.
-bool store_result(const std::string& dir, const std::string& key, const gis::PipelineResult& result);
+/// Stores `result` for `key` in `dir` (created if needed), with `stamps`, the stamps of the files it was read from
+/// (result_cache.cpp): a later process uses it only while they are unchanged. False, with a CPLDebug line saying
+/// why, on failure.
+bool store_result(const std::string& dir, const std::string& key, const gis::PipelineResult& result,
+                  const std::string& stamps);
 
 }  // namespace groundplan::driver

@@ -63,9 +63,10 @@ class ReadResult(NamedTuple):
     layer). Without GeoPandas each is a list of dicts, one per feature, the geometry under ``"geometry"``
     as a Shapely geometry (or WKB bytes without Shapely).
 
-    plans:      gp_id, n_parts, area_m2, min_z, max_z, building_ids, geometry (Polygon)
-    footprints: fp_id, source_id, source_file, method, gp_id (None when in no plan), min_z, max_z,
-                geometry (MultiPolygon)
+    plans:      gp_id, n_parts, area_m2, min_z, max_z, building_ids (the members' ids), buildings (their
+                Buildings' ids, each once: a BuildingPart's Building), geometry (Polygon)
+    footprints: fp_id, source_id, source_file, method, gp_id (None when in no plan), min_z, max_z (metres),
+                building_id (the Building of a BuildingPart, else source_id), geometry (MultiPolygon)
     problems:   source_id, file, stage, code, reason
     crs:        the working CRS as WKT (empty when the input has none)
     stats:      buildings read and dropped, blocks, backend, seconds per stage

@@ -31,10 +31,11 @@ from qgis.PyQt.QtCore import QVariant
 # The layers' fields as the CLI writes them (driver/src/ogr_groundplan_datasource.cpp); the algorithm checks
 # the module's columns against them, so a field added there cannot go missing here unnoticed.
 PLAN_FIELDS = [("gp_id", QVariant.LongLong), ("n_parts", QVariant.Int), ("area_m2", QVariant.Double),
-               ("min_z", QVariant.Double), ("max_z", QVariant.Double), ("building_ids", QVariant.String)]
+               ("min_z", QVariant.Double), ("max_z", QVariant.Double), ("building_ids", QVariant.String),
+               ("buildings", QVariant.String)]
 FOOTPRINT_FIELDS = [("fp_id", QVariant.LongLong), ("source_id", QVariant.String), ("source_file", QVariant.String),
                     ("method", QVariant.String), ("gp_id", QVariant.LongLong), ("min_z", QVariant.Double),
-                    ("max_z", QVariant.Double)]
+                    ("max_z", QVariant.Double), ("building_id", QVariant.String)]
 PROBLEM_FIELDS = [("source_id", QVariant.String), ("file", QVariant.String), ("stage", QVariant.String),
                   ("code", QVariant.String), ("reason", QVariant.String)]
 

@@ -136,3 +136,59 @@ def parts(tmp_path_factory):
                                 "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::25832"}},
                                 "features": features}))
     return path
+
+
+def _box_faces(x, y, w, d, z0, z1):
+    """The six faces of an axis-aligned box as posList strings (outward rings)."""
+    a, b, c, e = (x, y), (x + w, y), (x + w, y + d), (x, y + d)
+
+    def ring(pts):
+        pts = pts + [pts[0]]
+        return " ".join(f"{px} {py} {pz}" for px, py, pz in pts)
+
+    bottom = [(*a, z0), (*e, z0), (*c, z0), (*b, z0)]
+    top = [(*a, z1), (*b, z1), (*c, z1), (*e, z1)]
+    walls = [[(*p, z0), (*q, z0), (*q, z1), (*p, z1)] for p, q in ((a, b), (b, c), (c, e), (e, a))]
+    return [ring(f) for f in [bottom, top] + walls]
+
+
+def _solid(boxes):
+    faces = "".join(f"<gml:surfaceMember><gml:Polygon><gml:exterior><gml:LinearRing><gml:posList srsDimension=\"3\">"
+                    f"{f}</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember>"
+                    for box in boxes for f in _box_faces(*box))
+    return (f"<bldg:lod1Solid><gml:Solid><gml:exterior><gml:CompositeSurface>{faces}</gml:CompositeSurface>"
+            f"</gml:exterior></gml:Solid></bldg:lod1Solid>")
+
+
+def write_citygml(path, buildings, srs_name=None, envelope_on=None):
+    """A CityGML 2.0 file of box buildings. `buildings`: [(id, boxes, parts)] where boxes are (x, y, w, d, z0, z1) of
+    the Building's own solid and parts [(part id, boxes)] its BuildingParts'. `srs_name` goes on the CityModel's
+    envelope, or, with envelope_on="LandUse" ("LandUse-after"), only on the envelope of a LandUse object written
+    before (after) the buildings."""
+    xs = [b[0] for _, boxes, parts in buildings for b in boxes + [bb for _, pb in parts for bb in pb]]
+    ys = [b[1] for _, boxes, parts in buildings for b in boxes + [bb for _, pb in parts for bb in pb]]
+    env = ""
+    srs_attr = f' srsName="{srs_name}"' if srs_name else ""
+    corners = (f"<gml:lowerCorner>{min(xs)} {min(ys)} 0</gml:lowerCorner>"
+               f"<gml:upperCorner>{max(xs) + 100} {max(ys) + 100} 100</gml:upperCorner>")
+    if envelope_on is None:
+        env = f'<gml:boundedBy><gml:Envelope{srs_attr} srsDimension="3">{corners}</gml:Envelope></gml:boundedBy>'
+    members = []
+    if envelope_on in ("LandUse", "LandUse-after"):
+        members.append(f'<core:cityObjectMember><luse:LandUse gml:id="LU1"><gml:boundedBy><gml:Envelope{srs_attr} '
+                       f'srsDimension="3">{corners}</gml:Envelope></gml:boundedBy></luse:LandUse></core:cityObjectMember>')
+    for bid, boxes, parts in buildings:
+        body = _solid(boxes) if boxes else ""
+        for pid, pboxes in parts:
+            body += (f'<bldg:consistsOfBuildingPart><bldg:BuildingPart gml:id="{pid}">{_solid(pboxes)}'
+                     f'</bldg:BuildingPart></bldg:consistsOfBuildingPart>')
+        members.append(f'<core:cityObjectMember><bldg:Building gml:id="{bid}">{body}</bldg:Building></core:cityObjectMember>')
+    if envelope_on == "LandUse-after":
+        members.append(members.pop(0))
+    pathlib.Path(path).write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        '<core:CityModel xmlns:core="http://www.opengis.net/citygml/2.0" '
+        'xmlns:bldg="http://www.opengis.net/citygml/building/2.0" '
+        'xmlns:luse="http://www.opengis.net/citygml/landuse/2.0" xmlns:gml="http://www.opengis.net/gml">\n'
+        + env + "\n".join(members) + "\n</core:CityModel>\n")
+    return path

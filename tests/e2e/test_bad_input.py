@@ -97,11 +97,67 @@ def test_bad_file(tmp_path, name):
             assert pr["file"] == str(src) or pathlib.Path(pr["file"]).resolve().is_relative_to(CORPUS), pr
             texts.append(pr["reason"])
         texts.append(out.read_bytes().decode("latin-1"))
+    elif "nothing usable" in p.stderr:
+        # The problems layer asked for is still written, alone (no empty plans that would look like a result).
+        ds = ogr.Open(str(out))
+        assert [ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())] == ["problems"]
+        problems = [f.items() for f in ds.GetLayer(0)]
+        assert problems and set(want["codes"]) <= {pr["code"] for pr in problems}
+        texts += [pr["reason"] for pr in problems]
     else:
         assert not out.exists() or want.get("output_written", False)
     for t in texts:
         for line in PASSWD:
             assert line not in t, "content of /etc/passwd in the output"
+
+
+@pytest.mark.parametrize("tiles", ["off", "on"])
+def test_problems_layer_is_written_when_nothing_is_usable(tmp_path, tiles):
+    """1,000 buildings, none usable (a ring of two points each): the run fails, and the problems layer asked for
+    holds every one of them; the message says where they are. Without the layer asked for, nothing is written."""
+    members = "".join(
+        f'<core:cityObjectMember><bldg:Building gml:id="BAD_{i}"><bldg:lod1Solid><gml:Solid><gml:exterior>'
+        f'<gml:CompositeSurface><gml:surfaceMember><gml:Polygon><gml:exterior><gml:LinearRing><gml:posList>'
+        f'{i} 0 0 {i} 1 0</gml:posList></gml:LinearRing></gml:exterior></gml:Polygon></gml:surfaceMember>'
+        f'</gml:CompositeSurface></gml:exterior></gml:Solid></bldg:lod1Solid></bldg:Building></core:cityObjectMember>\n'
+        for i in range(1000))
+    src = tmp_path / "bad.gml"
+    src.write_text('<?xml version="1.0"?>\n<core:CityModel xmlns:core="http://www.opengis.net/citygml/2.0" '
+                   'xmlns:bldg="http://www.opengis.net/citygml/building/2.0" xmlns:gml="http://www.opengis.net/gml">'
+                   '<gml:boundedBy><gml:Envelope srsName="EPSG:25832"><gml:lowerCorner>0 0 0</gml:lowerCorner>'
+                   '<gml:upperCorner>1000 1 0</gml:upperCorner></gml:Envelope></gml:boundedBy>\n'
+                   + members + "</core:CityModel>\n")
+    out = tmp_path / "out.gpkg"
+    p = run([BIN, "--tiles", tiles, "-f", "GPKG", out, src, "ground_plans", "problems"], check=False)
+    assert p.returncode == 1, p.stderr
+    assert "nothing usable: 1000 buildings read" in p.stderr and "only the 'problems' layer written" in p.stderr
+    assert f"all are in the 'problems' layer of {out}" in p.stderr, p.stderr
+    ds = ogr.Open(str(out))
+    assert [ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())] == ["problems"]
+    named = {f["source_id"] for f in ds.GetLayer(0) if f["code"] != "NOTE"}
+    assert named == {f"BAD_{i}" for i in range(1000)}
+    plans_only = tmp_path / "plans.gpkg"
+    p = run([BIN, "--tiles", tiles, "-f", "GPKG", plans_only, src], check=False)
+    assert p.returncode == 1 and not plans_only.exists()
+    assert "nothing written" in p.stderr and "write the 'problems' layer to see them all" in p.stderr
+
+
+@pytest.mark.parametrize("tiles", ["off", "on"])
+def test_problems_layer_is_written_when_no_input_can_be_read(tmp_path, tiles):
+    """Every input unreadable: the problems layer asked for names each file and its fault; the run fails."""
+    folder = tmp_path / "bad"
+    folder.mkdir()
+    (folder / "a_empty.gml").write_text("")
+    (folder / "b_garbage.gml").write_bytes(bytes(range(256)) * 4)
+    out = tmp_path / "out.gpkg"
+    p = run([BIN, "--tiles", tiles, "-f", "GPKG", out, folder, "ground_plans", "problems"], check=False)
+    assert p.returncode == 1, p.stderr
+    assert "only the 'problems' layer written" in p.stderr, p.stderr
+    ds = ogr.Open(str(out))
+    assert [ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())] == ["problems"]
+    unreadable = {pathlib.Path(f["file"]).name: f["reason"] for f in ds.GetLayer(0) if f["code"] == "UNREADABLE_FILE"}
+    assert set(unreadable) == {"a_empty.gml", "b_garbage.gml"}
+    assert "empty" in unreadable["a_empty.gml"]
 
 
 def test_whole_corpus_folder_as_one_input(tmp_path):

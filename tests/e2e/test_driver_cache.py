@@ -11,7 +11,7 @@ import textwrap
 import pytest
 from osgeo import gdal, ogr
 
-from conftest import PLATEAU_SMALL, PLUGIN_DIR, gdal_env, run
+from conftest import PLATEAU_SMALL, PLUGIN_DIR, SOURCE_DIR, gdal_env, run
 
 gdal.UseExceptions()
 
@@ -80,14 +80,54 @@ def test_a_changed_input_is_computed_again(sample):
         st = os.stat("{sample}")
         os.utime("{sample}", ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
         again = count("GROUNDPLAN:{sample}")
-        # A new file beside it (a glTF buffer or a KML model could be one): computed again.
-        shutil.copy("{sample}", "{sample.parent}/other.bin")
+        # Files beside it that no reader opens (the output written next to the input, a log): nothing changes.
+        gdal.VectorTranslate("{sample.parent}/plans.gpkg", gdal.OpenEx("GROUNDPLAN:{sample}", gdal.OF_VECTOR),
+                             format="GPKG")
+        open("{sample.parent}/run.log", "w").write("log")
         third = count("GROUNDPLAN:{sample}")
         fourth = count("GROUNDPLAN:{sample}")
         print([before, again, third, fourth])
     """)
     assert len(set(eval(out))) == 1
-    assert len(runs) == 3, runs  # the fourth open finds the third's result
+    assert len(runs) == 2, runs  # the change computed again; the files written beside it did not
+
+
+def _kml_with_model(folder, size):
+    """A KML placing one COLLADA box of `size` metres (models/box.dae beside it)."""
+    (folder / "models").mkdir(exist_ok=True)
+    dae = (SOURCE_DIR / "tests" / "corpus" / "bad" / "kml_models" / "good_box.dae").read_text()
+    (folder / "models" / "box.dae").write_text(dae.replace("0 0 0 10 0 0 10 8 0 0 8 0 0 0 6 10 0 6 10 8 6 0 8 6",
+                                                           f"0 0 0 {size} 0 0 {size} 8 0 0 8 0 0 0 6 {size} 0 6 "
+                                                           f"{size} 8 6 0 8 6"))
+    kml = folder / "city.kml"
+    kml.write_text('<?xml version="1.0" encoding="UTF-8"?><kml xmlns="http://www.opengis.net/kml/2.2"><Document>'
+                   '<Placemark id="BOX"><Model><Location><longitude>127.17</longitude><latitude>37.62</latitude>'
+                   '<altitude>0</altitude></Location><Link><href>models/box.dae</href></Link></Model></Placemark>'
+                   '</Document></kml>')
+    return kml
+
+
+def test_a_changed_linked_model_is_computed_again_a_file_beside_is_not(tmp_path):
+    kml = _kml_with_model(tmp_path, 10)
+    out, runs, hits = run_script(f"""
+        def area():
+            ds = gdal.OpenEx("GROUNDPLAN:{kml}", gdal.OF_VECTOR)
+            return round(sum(f["area_m2"] for f in ds.GetLayerByName("ground_plans")), 3)
+        first = area()
+        gdal.VectorTranslate("{tmp_path}/plans.gpkg", gdal.OpenEx("GROUNDPLAN:{kml}", gdal.OF_VECTOR), format="GPKG")
+        open("{tmp_path}/models/notes.txt", "w").write("not read")
+        second = area()
+        import pathlib, os
+        dae = pathlib.Path("{tmp_path}/models/box.dae")
+        dae.write_text(dae.read_text().replace(" 10 0 0 10 8 0 ", " 20 0 0 20 8 0 ").replace(" 10 0 6 10 8 6 ", " 20 0 6 20 8 6 "))
+        third = area()
+        fourth = area()
+        print([first, second, third, fourth])
+    """)
+    first, second, third, fourth = eval(out)
+    assert first == pytest.approx(80, rel=1e-3) and second == first
+    assert third == pytest.approx(160, rel=1e-3) and fourth == third
+    assert len(runs) == 2, runs  # the first open, and the one after the model changed
 
 
 def test_concurrent_opens_of_one_key_compute_once(sample):

@@ -285,3 +285,33 @@ def test_algorithm_folder_preset_and_crs_match_the_driver(qgis_env, tmp_path):
     for (a, ga), (b, gb) in zip(ours, theirs):
         assert a == b
         assert ogr.CreateGeometryFromWkb(bytes.fromhex(ga)).Equals(ogr.CreateGeometryFromWkb(bytes.fromhex(gb)))
+
+
+def test_saving_the_output_beside_the_input_does_not_compute_again(qgis_env, sample):
+    """The usual QGIS session: load the plans, save them as a GeoPackage next to city.gml (and a log), load the
+    layer again: one pipeline run. Then the input changes: computed again."""
+    got, runs, _ = run_qgis(qgis_env, f"""
+        import os
+        from qgis.core import QgsVectorLayer, QgsVectorFileWriter, QgsCoordinateTransformContext
+        def load():
+            layer = QgsVectorLayer("GROUNDPLAN:{sample}|layername=ground_plans", "gp", "ogr")
+            assert layer.isValid(), layer.error().summary()
+            return layer, layer.featureCount()
+        layer, first = load()
+        opts = QgsVectorFileWriter.SaveVectorOptions()
+        opts.driverName = "GPKG"
+        err = QgsVectorFileWriter.writeAsVectorFormatV3(layer, "{sample.parent}/ground_plans.gpkg",
+                                                        QgsCoordinateTransformContext(), opts)
+        assert err[0] == QgsVectorFileWriter.NoError, err
+        open("{sample.parent}/session.log", "w").write("saved")
+        del layer
+        layer, second = load()
+        st = os.stat("{sample}")
+        os.utime("{sample}", ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+        del layer
+        layer, third = load()
+        print(json.dumps([first, second, third, os.path.exists("{sample.parent}/ground_plans.gpkg")]))
+    """)
+    first, second, third, saved = got
+    assert saved and first == second == third > 0
+    assert len(runs) == 2, runs  # the first load and the one after the input changed; not the one after saving

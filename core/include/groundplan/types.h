@@ -33,7 +33,11 @@ struct Footprint {
   std::string method;             // how it was found: to_string(FootprintMethod), e.g. "ground-surface"
   double min_z = 0;               // lowest / highest vertex height of the source mesh (metres)
   double max_z = 0;
+  std::string parent_id;          // the Building a BuildingPart belongs to (Mesh::parent_id); empty for a Building
 };
+
+/// The id of the Building a footprint belongs to: its parent's for a BuildingPart, else its own.
+inline const std::string& building_id_of(const Footprint& f) { return f.parent_id.empty() ? f.source_id : f.parent_id; }
 
 /// One connected region of the union of footprints: exactly one outer ring (CCW) and its holes (CW).
 struct GroundPlan {

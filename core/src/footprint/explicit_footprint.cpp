@@ -163,6 +163,7 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   FootprintResult res;
   Footprint& fp = res.footprint;
   fp.source_id = mesh.source_id;
+  fp.parent_id = mesh.parent_id;
   fp.source_file = mesh.source_file;
   if (mesh.faces.empty() || mesh.vertices.empty()) {
     res.code = "EMPTY_MESH";

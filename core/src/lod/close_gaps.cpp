@@ -423,12 +423,12 @@ GroupResult close_group(const std::vector<GroundPlan>& plans, const GroundPlan& 
 
   // The input plans, unmoved, united with the reconciled closing (one even-odd polygon).
   std::vector<Footprint> fps;
-  for (std::uint32_t i : group) fps.push_back(Footprint{{plans[i].polygon}, {}, {}, {}, 0, 0});
+  for (std::uint32_t i : group) fps.push_back(Footprint{{plans[i].polygon}, {}, {}, {}, 0, 0, {}});
   if (!eroded.empty()) {
     Polygon e;
     e.outer = std::move(eroded.front());
     e.holes.assign(std::make_move_iterator(eroded.begin() + 1), std::make_move_iterator(eroded.end()));
-    fps.push_back(Footprint{{std::move(e)}, {}, {}, {}, 0, 0});
+    fps.push_back(Footprint{{std::move(e)}, {}, {}, {}, 0, 0, {}});
   }
   std::vector<GroundPlan> united = build_ground_plans(fps, one_thread, ignored);
   throw_if_failed(ignored, "closing with its input");

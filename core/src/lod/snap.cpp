@@ -332,6 +332,7 @@ std::vector<Footprint> snap_footprints(const std::vector<Footprint>& footprints,
   for (const Footprint& f : footprints) {
     Footprint g;
     g.source_id = f.source_id;
+    g.parent_id = f.parent_id;
     g.source_file = f.source_file;
     g.method = f.method;
     g.min_z = f.min_z;

@@ -15,6 +15,7 @@
 #include <groundplan/gis/citygml_chunks.h>
 
 #include "citygml/coordinates.h"
+#include "coordinate_limit.h"
 #include "citygml/element_names.h"
 #include "citygml/file_problems.h"
 #include "xml/block_cache.h"
@@ -910,10 +911,8 @@ class Reader : private xml::DomEvents::Sink {
     for (double v : coords_) {
       if (std::fabs(v) > opt_.max_abs_coordinate) {
         if (poly_ok_) {
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "%.6g", v);
-          b.defect("COORDINATE_OUT_OF_RANGE", "polygon " + poly_label() + " has the coordinate " + buf +
-                                                  ", beyond any position on Earth in any CRS; dropped");
+          b.defect("COORDINATE_OUT_OF_RANGE",
+                   "polygon " + poly_label() + ": " + beyond_coordinate_limit(v, opt_.max_abs_coordinate) + "; dropped");
         }
         poly_ok_ = false;
         return;

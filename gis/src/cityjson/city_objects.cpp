@@ -6,6 +6,7 @@
 // "semantics.surfaces" (or null). A GeometryInstance places a template: vertex = M * template vertex
 // + the instance's reference point (its one boundary index).
 #include "cityjson/city_objects.h"
+#include "coordinate_limit.h"
 
 #include <groundplan/error.h>
 
@@ -234,8 +235,9 @@ class GeometryWalker {
             defects_.add("NOT_FINITE", "vertex " + std::to_string(i) +
                                            " is not three finite numbers; its surface is dropped");
           else
-            defects_.add("COORDINATE_OUT_OF_RANGE", "vertex " + std::to_string(i) + " lies beyond " +
-                                                        std::to_string(max_abs_) + "; its surface is dropped");
+            defects_.add("COORDINATE_OUT_OF_RANGE", "vertex " + std::to_string(i) + ": " +
+                                                        beyond_coordinate_limit(max_abs_) +
+                                                        "; its surface is dropped");
           return;
         }
         face.point(p);

@@ -69,6 +69,7 @@ struct WorkingFrame::Impl {
   bool src_known = false;
   bool src_metric_projected = false;
   bool swap_in = false;  // file writes the other axis order than the CRS's: swap x/y before PROJ
+  double z_to_metre = 1;  // heights as written -> metres (the vertical CRS's unit, else the horizontal one's)
   // What the constructor decided, restored for every frame that reuses this Impl:
   std::vector<std::string> base_notes;
   bool base_identity = false;
@@ -119,6 +120,46 @@ struct WorkingFrame::Impl {
     if (!proj_cs_get_axis_info(ctx, cs.get(), 0, nullptr, nullptr, nullptr, &factor, nullptr, nullptr, nullptr))
       return false;
     return std::fabs(factor - 1.0) < 1e-12;
+  }
+
+  /// The unit factor (to metres) of axis `axis` of `crs`'s coordinate system; 0 when PROJ does not say.
+  double axis_unit(PJ* crs, int axis) const {
+    PjPtr cs(crs ? proj_crs_get_coordinate_system(ctx, crs) : nullptr);
+    if (!cs || proj_cs_get_axis_count(ctx, cs.get()) <= axis) return 0;
+    double factor = 0;
+    if (!proj_cs_get_axis_info(ctx, cs.get(), axis, nullptr, nullptr, nullptr, &factor, nullptr, nullptr, nullptr))
+      return 0;
+    return factor > 0 && std::isfinite(factor) ? factor : 0;
+  }
+
+  /// Heights as written -> metres. The vertical CRS decides where the source names one (a compound CRS, or
+  /// "EPSG:h+v"): NAVD88 height (ftUS) is in US survey feet. Else a 3D geographic CRS's height axis, else
+  /// metres for a 2D geographic CRS (ellipsoidal heights), and the horizontal unit for a projected one:
+  /// a file in EPSG:2263 (US survey feet) writes its heights in feet too. `whole`: the source CRS as PROJ
+  /// made it (null when it was the horizontal CRS itself, now src_h).
+  double height_unit(PJ* whole, std::vector<std::string>& notes) const {
+    PjPtr vertical;
+    if (whole && proj_get_type(whole) == PJ_TYPE_COMPOUND_CRS) vertical.reset(proj_crs_get_sub_crs(ctx, whole, 1));
+    if (!vertical && source.vertical_epsg)
+      vertical.reset(proj_create(ctx, ("EPSG:" + std::to_string(source.vertical_epsg)).c_str()));
+    double f = 0;
+    if (vertical) {
+      f = axis_unit(vertical.get(), 0);
+    } else if (src_type == PJ_TYPE_GEOGRAPHIC_3D_CRS) {
+      f = axis_unit(src_h.get(), 2);
+    } else if (src_type == PJ_TYPE_PROJECTED_CRS) {
+      f = axis_unit(src_h.get(), 0);
+    } else {
+      f = 1;
+    }
+    if (f == 0) {
+      notes.push_back("PROJ gives no unit for the heights of \"" + source.text + "\": min_z and max_z kept as written");
+      return 1;
+    }
+    if (std::fabs(f - 1) > 1e-12)
+      notes.push_back("heights of \"" + source.text + "\" are in units of " + fmt(f) +
+                      " m (" + (vertical ? "its vertical CRS" : "its horizontal unit") + "): converted to metres");
+    return f;
   }
 
   /// Does the CRS put north (latitude/northing) first in its authority axis order?
@@ -265,6 +306,7 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
       if (m.src_type == PJ_TYPE_PROJECTED_CRS || is_geographic(m.src_type)) {
         m.src_known = true;
         m.src_metric_projected = m.projected_metric(m.src_h.get());
+        m.z_to_metre = m.height_unit(src.get(), notes);
       } else {
         notes.push_back("srsName \"" + source_srs + "\" is neither a projected nor a geographic CRS (" +
                         (m.src_type == PJ_TYPE_GEOCENTRIC_CRS ? "geocentric" : "other") +
@@ -277,6 +319,9 @@ WorkingFrame::WorkingFrame(const std::string& source_srs, const CrsOptions& opti
                         ? "the file has no srsName: coordinates kept as written, CRS unknown"
                         : "srsName \"" + source_srs + "\" is a CRS local to the file: coordinates kept as written, CRS unknown");
   }
+  if (!m.src_known)
+    notes.back() += "; the output is labelled an undefined Cartesian SRS (not georeferenced); to georeference it, name "
+                    "the CRS the coordinates are in with -a_srs (open option A_SRS), e.g. -a_srs EPSG:25832";
 
   if (m.src_known) {
     bool authority_north_first = is_geographic(m.src_type) && m.north_first(m.src_h.get());
@@ -404,7 +449,10 @@ bool WorkingFrame::transform_point(double& x, double& y) const {
 
 bool WorkingFrame::transform(Mesh& mesh, std::string* reason) {
   Impl& m = *impl_;
-  if (m.identity || mesh.vertices.empty()) return true;
+  if (mesh.vertices.empty()) return true;
+  if (m.z_to_metre != 1)
+    for (Point3& p : mesh.vertices) p.z *= m.z_to_metre;
+  if (m.identity) return true;
   if (!m.decided) {
     double lo_x = mesh.vertices[0].x, hi_x = lo_x, lo_y = mesh.vertices[0].y, hi_y = lo_y;
     for (const Point3& p : mesh.vertices) {
@@ -511,7 +559,8 @@ std::string WorkingFrame::area_of_use_mismatch(double x, double y) const {
 
 bool WorkingFrame::source_known() const { return impl_->src_known; }
 bool WorkingFrame::source_geographic() const { return is_geographic(impl_->src_type); }
-bool WorkingFrame::identity() const { return impl_->identity; }
+bool WorkingFrame::identity() const { return impl_->identity && impl_->z_to_metre == 1; }
+double WorkingFrame::height_to_metre() const { return impl_->z_to_metre; }
 const SrsName& WorkingFrame::source() const { return impl_->source; }
 const WorkingCrs& WorkingFrame::working_crs() const {
   static const WorkingCrs kNone;

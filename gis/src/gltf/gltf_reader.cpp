@@ -6,6 +6,7 @@
 #include <groundplan/gis/gltf.h>
 
 #include "collada/collada_internal.h"
+#include "files_read.h"
 #include "xml/safe_xml.h"
 
 #define TINYGLTF_NO_STB_IMAGE
@@ -66,6 +67,7 @@ bool fs_exists(const std::string& path, void* ud) {
     if (g->refused.empty()) g->refused = path;
     return false;
   }
+  note_file_opened(path);  // a buffer looked for: the result depends on it, there or not
   VSIStatBufL st;
   return VSIStatL(path.c_str(), &st) == 0;
 }

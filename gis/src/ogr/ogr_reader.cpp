@@ -4,6 +4,8 @@
 #include <groundplan/error.h>
 #include <groundplan/gis/ogr_input.h>
 
+#include "coordinate_limit.h"
+#include "files_read.h"
 #include "ogr/ogr_source.h"
 
 #include <cpl_error.h>
@@ -334,6 +336,10 @@ void open_source(const std::string& path, const OgrInputOptions& options, Source
   }
   GDALDataset* ds = src.ds.get();
   if (GDALDriver* d = ds->GetDriver()) info.driver = d->GetDescription();
+  {  // the dataset's files (a shapefile's .shp, .shx, .dbf, .prj ...): the result cache keys on them
+    const CPLStringList files(ds->GetFileList());
+    for (int i = 0; i < files.size(); ++i) note_file_opened(files[i]);
+  }
 
   // The layers to read: an SQL result, the named ones, or all.
   std::vector<LayerPlan>& plans = src.plans;
@@ -443,7 +449,7 @@ void FeatureReader::read(LayerPlan& p, OGRFeature& feature) {
                                 " has no area: only polygons and surfaces are footprints");
   if (f.non_finite) return bad("BAD_COORDINATES", "a coordinate is NaN or infinite");
   if (f.max_abs > options_.max_abs_coordinate)
-    return bad("COORDINATE_OUT_OF_RANGE", "a coordinate's magnitude exceeds " + std::to_string(options_.max_abs_coordinate));
+    return bad("COORDINATE_OUT_OF_RANGE", beyond_coordinate_limit(f.max_abs, options_.max_abs_coordinate));
   if (f.mesh.vertices.size() > options_.max_vertices)
     return bad("TOO_MANY_VERTICES", std::to_string(f.mesh.vertices.size()) + " vertices, more than the limit of " +
                                         std::to_string(options_.max_vertices));

@@ -5,6 +5,8 @@
 // footprints made on the other cores while the reader reads on.
 #include "pipeline/file_reading.h"
 #include "citygml/in_memory.h"
+#include "citygml/srs_scan.h"
+#include "files_read.h"
 
 #include <groundplan/error.h>
 #include <groundplan/gis/citygml_chunks.h>
@@ -102,17 +104,33 @@ class Placer {
         frame_srs = !options_.s_srs.empty()                             ? options_.s_srs
                     : read_info_ && !read_info_->source_srs.empty() ? read_info_->source_srs
                                                                     : citygml_.srs_name;
+        // A CityGML file (a chunk's format is not set: only CityGML is read in chunks) that names its CRS only
+        // after its first building, on another object's envelope: that srsName holds for the whole file.
+        const InputFormat format = read_info_ ? read_info_->format : InputFormat::CityGml;
+        if (frame_srs.empty() && options_.s_srs.empty() &&
+            (format == InputFormat::CityGml || format == InputFormat::Unknown)) {
+          frame_srs = citygml::first_srs_name_in(file_);
+          srs_found_later = !frame_srs.empty();
+        }
         if (kept_ && kept_->frame && kept_->srs == frame_srs)
           frame = std::move(kept_->frame);  // same srsName, options and decision: the same frame
         else
-          frame = std::make_unique<WorkingFrame>(frame_srs, crs, file_);
+          frame = make_frame(crs);
         if (decision_ && !frame->decided()) frame->decide((*decision_)[0], (*decision_)[1]);
         // The file's first building (not a later chunk's: those come with decision_) against the
         // area of use of the CRS it is read in: a wrong label says so once, naming that building.
         check_area = !decision_ && !mesh.vertices.empty();
       }
+      if (without_crs) {
+        // No CRS among georeferenced inputs: the building cannot be placed; the file's NO_CRS problem says why.
+        part.problems.push_back({mesh.source_id, file_, "georeference", "NO_CRS",
+                                 "its file has no CRS, unlike the other inputs (" + context_.working_definition +
+                                     "): left out (the file's NO_CRS problem says more)"});
+        ++part.buildings_dropped;
+        return false;
+      }
       const bool georeferenced = in_working_crs_ || (frame && frame->source_known());
-      if (georeferenced && !context_.unknown_frame_file.empty())
+      if (georeferenced && !context_.unknown_frame_file.empty() && !context_.georeferenced_wins)
         throw InvalidArgument(file_ + ": has a CRS, but " + context_.unknown_frame_file +
                               " (read before it) has none, so their coordinates cannot be combined; give every "
                               "input a CRS, or process them separately");
@@ -182,7 +200,25 @@ class Placer {
                           "their CRS with -s_srs";
   }
 
+  /// The frame for frame_srs. Where the working CRS comes from another file (not -t_srs) and this file has no CRS,
+  /// a frame without target, and without_crs set: a file without CRS cannot join georeferenced ones.
+  std::unique_ptr<WorkingFrame> make_frame(const CrsOptions& crs) {
+    try {
+      return std::make_unique<WorkingFrame>(frame_srs, crs, file_);
+    } catch (const InvalidArgument&) {
+      if (!options_.t_srs.empty() || crs.target_srs.empty()) throw;  // -t_srs asked for: its own message
+      CrsOptions own = crs;
+      own.target_srs.clear();
+      auto f = std::make_unique<WorkingFrame>(frame_srs, own, file_);
+      if (f->source_known()) throw;
+      without_crs = true;
+      return f;
+    }
+  }
+
   std::unique_ptr<WorkingFrame> frame;
+  bool without_crs = false;   // the file has no CRS, the other inputs have one: its buildings are left out
+  bool srs_found_later = false;  // the srsName was found after the first building (citygml/srs_scan.h)
   bool check_area = false;    // the next mesh is the file's first: check it against the CRS's area of use
   bool area_warning = false;  // that check warned
   std::string frame_srs;                             // the srsName the frame was made from
@@ -323,8 +359,9 @@ void append_parts(std::vector<Part>& parts, const std::string& file, FileRead& o
 }
 
 /// The file's last words: buildings the reader gave up, notes, and the CRS facts for the pipeline.
-void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info,
-                 const WorkingFrame* frame, const std::string& file, const PipelineOptions& options) {
+void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info, const Placer* placer,
+                 const std::string& file, const PipelineOptions& options, const ReadContext& context) {
+  const WorkingFrame* frame = placer ? placer->frame.get() : nullptr;
   // Buildings the reader gave up count as read and dropped: nothing is lost silently. Whatever the
   // format, such a building is named by a read-stage Problem and gave no mesh (a building that did
   // give one may have read-stage defects too: a dropped face, a missing xlink).
@@ -349,7 +386,15 @@ void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info
     out.in_working_crs = true;
     out.reader_crs = info.working_crs;
   }
-  if (frame) {
+  if (frame && placer->without_crs) {
+    out.problems.push_back({"", file, "georeference", "NO_CRS",
+                            no_crs_reason(file, no_crs_cause(placer->frame_srs), context.working_definition)});
+  } else if (frame) {
+    if (placer->srs_found_later)
+      out.problems.push_back({"", file, "georeference", "NOTE",
+                              "srsName \"" + placer->frame_srs.substr(0, 200) +
+                                  "\" is written only after the file's first building (on another object's "
+                                  "envelope): it holds for the whole file"});
     if (!options.s_srs.empty())
       out.problems.push_back({"", file, "georeference", "NOTE",
                               "source CRS " + options.s_srs + " from -s_srs/-a_srs (the file says \"" +
@@ -358,6 +403,7 @@ void finish_file(FileRead& out, const Delivered& delivered, const ReadInfo& info
     out.has_frame = true;
     out.frame_source_known = frame->source_known();
     out.frame_crs = frame->working_crs();
+    out.frame_srs = placer->frame_srs;
   }
 }
 
@@ -386,8 +432,10 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
     bytes.add(n);
   };
   Placer placer(file, options, context, info.in_working_crs, info.citygml, {}, nullptr, &info);
+  out.files_opened.push_back(file);
   {
     FootprintMaker maker(options, true);
+    FilesHeard heard(out.files_opened);
     try {
       read_any(file, read_options, [&](Mesh&& mesh) {
         if (placer.place(mesh, part)) maker.add(std::move(mesh), part);
@@ -419,7 +467,7 @@ FileRead read_whole(const std::string& file, const PipelineOptions& options, con
   std::vector<Part> parts(1);
   parts[0] = std::move(part);
   append_parts(parts, file, out, delivered);
-  finish_file(out, delivered, info, placer.frame.get(), file, options);
+  finish_file(out, delivered, info, &placer, file, options, context);
   return out;
 }
 
@@ -429,6 +477,14 @@ struct SideBySide {
   std::vector<Part> parts;
   std::vector<std::unique_ptr<Placer>> placers;
   const Placer* first = nullptr;  // the part whose frame stands for the file's
+  std::vector<std::vector<std::string>> opened;  // the files each part's reader opened (files_read.h)
+
+  /// The file and what the parts opened, for FileRead::files_opened.
+  std::vector<std::string> files_opened(const std::string& file) const {
+    std::vector<std::string> all{file};
+    for (const auto& o : opened) all.insert(all.end(), o.begin(), o.end());
+    return all;
+  }
 };
 
 /// Reads part k: its meshes to on_mesh, its problems to problems. Throws to say the parts are not the
@@ -442,6 +498,7 @@ std::string read_side_by_side(const std::string& file, const PipelineOptions& op
   const std::size_t n = infos.size();
   s.parts.assign(n, Part{});
   s.placers.resize(n);
+  s.opened.assign(n, {});
   std::vector<std::optional<std::string>> frame_srs(n);  // what each part's frame was made from, if it made one
   tbb::enumerable_thread_specific<Placer::Kept> kept;
   std::vector<std::string> errors(n);
@@ -452,6 +509,7 @@ std::string read_side_by_side(const std::string& file, const PipelineOptions& op
     s.placers[k] = std::make_unique<Placer>(file, options, context, in_working_crs, infos[k].citygml, decision,
                                             keep ? &kept.local() : nullptr, &infos[k]);
     FootprintMaker maker(options, false);  // the parts keep every core busy already
+    FilesHeard heard(s.opened[k]);
     try {
       read_part(k, [&](Mesh&& mesh) {
         if (s.placers[k]->place(mesh, s.parts[k])) maker.add(std::move(mesh), s.parts[k]);
@@ -521,7 +579,8 @@ std::optional<FileRead> read_chunks(const std::string& file, const CityGmlChunkP
   ReadInfo info;
   info.citygml = merged;
   info.format = InputFormat::CityGml;
-  finish_file(out, delivered, info, s.first ? s.first->frame.get() : nullptr, file, options);
+  finish_file(out, delivered, info, s.first, file, options, context);
+  out.files_opened = s.files_opened(file);
   out.chunks = n;
   free_in_parallel(delivered);  // ~400k ids between them
   free_in_parallel(watches);
@@ -554,7 +613,8 @@ std::optional<FileRead> read_ogr_ranges(const std::string& file, const OgrRangeP
   append_parts(s.parts, file, out, delivered);
   VSIStatBufL st;
   if (VSIStatL(file.c_str(), &st) == 0) bytes.add(static_cast<std::uint64_t>(st.st_size));
-  finish_file(out, delivered, infos.front(), s.first ? s.first->frame.get() : nullptr, file, options);
+  finish_file(out, delivered, infos.front(), s.first, file, options, context);
+  out.files_opened = s.files_opened(file);
   out.chunks = n;
   return out;
 }
@@ -609,6 +669,18 @@ std::string guess_working_definition(const std::string& file, const PipelineOpti
   if (info.in_working_crs || !placer.frame || !placer.frame->source_known() || !placer.frame->decided()) return {};
   const WorkingCrs& crs = placer.frame->working_crs();
   return crs.known ? crs.definition : std::string{};
+
+std::string no_crs_cause(const std::string& srs) {
+  const SrsName name = parse_srs_name(srs);
+  if (srs.empty()) return "it names none (no srsName)";
+  if (name.local) return "its srsName \"" + srs.substr(0, 200) + "\" is a CRS local to the file";
+  return "its srsName \"" + srs.substr(0, 200) + "\" is no projected or geographic CRS PROJ knows";
+}
+
+std::string no_crs_reason(const std::string& file, const std::string& cause, const std::string& crs) {
+  return file + " has no CRS (" + cause + "), but the other inputs are georeferenced (" + crs +
+         "): its coordinates cannot be placed among theirs, so its buildings are left out (each a NO_CRS problem); "
+         "process it on its own, naming its CRS with -s_srs (open option S_SRS; it applies to every input)";
 }
 
 void ByteProgress::add(std::uint64_t n) {

@@ -22,7 +22,18 @@ namespace groundplan::gis::detail {
 struct ReadContext {
   std::string working_definition;  // -t_srs, or the first georeferenced file's working CRS
   std::string unknown_frame_file;  // a file read before without CRS (georeferenced files cannot join it)
+  /// run_pipeline: a georeferenced file read after files without CRS fixes the working CRS and those files are
+  /// set aside (set_aside_files_without_crs), as they are when read after it: the outcome does not depend on the
+  /// files' order. False (the tiled run, whose tiles are united as they are read): the georeferenced file fails.
+  bool georeferenced_wins = false;
 };
+
+/// Why a file without CRS cannot join georeferenced inputs: `cause` ("it has no srsName" ...), the working CRS
+/// `crs` ("EPSG:21781"). For the file's NO_CRS problem.
+std::string no_crs_reason(const std::string& file, const std::string& cause, const std::string& crs);
+/// `cause` for a file whose CRS (srsName, an OGR layer's CRS, -s_srs) `srs` is unknown: none, local or not one PROJ
+/// places.
+std::string no_crs_cause(const std::string& srs);
 
 /// One file's outcome, merged into the PipelineResult in file order.
 struct FileRead {
@@ -37,6 +48,8 @@ struct FileRead {
   WorkingCrs reader_crs;              // their working CRS
   bool has_frame = false;             // CityGML: a WorkingFrame was made
   bool frame_source_known = false;
+  std::string frame_srs;              // the CRS the frame was made from, as written (empty: none)
+  std::vector<std::string> files_opened;  // the file and what the readers opened for it (files_read.h)
   WorkingCrs frame_crs;
   // How it was read (--stats).
   std::size_t chunks = 0;             // > 0: CityGML read in this many chunks side by side

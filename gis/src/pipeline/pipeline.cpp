@@ -147,6 +147,11 @@ std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& i
   return files;
 }
 
+std::vector<std::string> input_files(const std::vector<std::string>& inputs) {
+  std::vector<Problem> ignored;  // unsafe zip entries: said by the run itself
+  return detail::expand_inputs(inputs, ignored);
+}
+
 const char* to_string(FootprintMode mode) {
   switch (mode) {
     case FootprintMode::Auto: return "auto";
@@ -236,6 +241,7 @@ void detail::merge_file(detail::FileRead&& r, const std::string& file, detail::R
     std::move(r.footprints.begin(), r.footprints.end(), std::back_inserter(result.footprints));
   }
   std::move(r.problems.begin(), r.problems.end(), std::back_inserter(result.problems));
+  result.files_read.insert(result.files_read.end(), r.files_opened.begin(), r.files_opened.end());
   if (r.failed) {
     ++files_failed;
     if (first_failure.empty()) first_failure = r.failure;
@@ -277,6 +283,35 @@ bool detail::guess_held(const detail::FileRead& first, const std::string& file, 
 
 namespace {
 
+/// True when the file's footprints are in a CRS (placed by their format, or read through a frame of a known CRS).
+bool georeferenced(const detail::FileRead& r) {
+  return (r.in_working_crs && r.reader_crs.known) || (r.has_frame && r.frame_source_known && r.frame_crs.known);
+}
+
+/// A georeferenced file read after files without CRS (`without_crs`: each file and its CRS as written): those files
+/// are set aside as they are when read after it (file_reading.cpp, Placer::without_crs), so that the files' order
+/// does not decide which are kept: each of their footprints becomes a NO_CRS problem (the building is dropped), each
+/// file gets one NO_CRS problem naming the cause and -s_srs, and their notes about a missing CRS go.
+void set_aside_files_without_crs(const std::vector<std::pair<std::string, std::string>>& without_crs,
+                                 const detail::FileRead& georeferenced_file, PipelineResult& result) {
+  const WorkingCrs& crs = georeferenced_file.in_working_crs ? georeferenced_file.reader_crs : georeferenced_file.frame_crs;
+  const std::string name = crs.epsg ? "EPSG:" + std::to_string(crs.epsg) : crs.name;
+  std::set<std::string> files;
+  for (const auto& f : without_crs) files.insert(f.first);
+  std::erase_if(result.problems, [&](const Problem& p) {
+    return p.code == "NOTE" && p.stage == "georeference" && p.source_id.empty() && files.count(p.file);
+  });
+  for (const Footprint& f : result.footprints)
+    result.problems.push_back({f.source_id, f.source_file, "georeference", "NO_CRS",
+                               "its file has no CRS, unlike the other inputs (" + name +
+                                   "): left out (the file's NO_CRS problem says more)"});
+  for (const auto& [file, srs] : without_crs)
+    result.problems.push_back(
+        {"", file, "georeference", "NO_CRS", detail::no_crs_reason(file, detail::no_crs_cause(srs), name)});
+  result.buildings_dropped += result.footprints.size();
+  result.footprints.clear();
+}
+
 /// Moves the footprints of reads[from..] to the end of `out`, in file order, side by side, and frees the files'
 /// emptied vectors the same way (merge_file then has none to move). One by one, the 15 later tiles of a 16-tile
 /// folder of the 1.5 GB city (186k footprints) cost one thread ~60 ms (tests/bench/RESULTS.md, "The serial steps
@@ -310,12 +345,14 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
   // rest are read side by side and merged in file order: the same result as one by one.
   detail::ReadContext context;
   context.working_definition = options.t_srs;
+  context.georeferenced_wins = true;
   std::size_t files_failed = 0;
   std::string first_failure;
   const auto t_read = clock_type::now();
   detail::ByteProgress bytes(progress.sub(0, 0.6), result.reading.bytes);
   progress.report(0, "reading");
   std::size_t fi = 0;
+  std::vector<std::pair<std::string, std::string>> without_crs;  // files read so far without CRS, and what they say
   // The working CRS guessed from the first file's first building: then the first file is read side by side with
   // the others (in the context it is read in alone), not before them.
   std::string guess = context.working_definition.empty() && files.size() > 1
@@ -323,9 +360,17 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
                           : std::string{};
   std::vector<detail::FileRead> reads;
   for (;;) {
-    for (; guess.empty() && fi < files.size() && context.working_definition.empty(); ++fi)
-      detail::merge_file(detail::read_file(files[fi], options, context, threads, 0, bytes), files[fi], context, result,
-                         files_failed, first_failure);
+    for (; guess.empty() && fi < files.size() && context.working_definition.empty(); ++fi) {
+      detail::FileRead r = detail::read_file(files[fi], options, context, threads, 0, bytes);
+      if (!without_crs.empty() && georeferenced(r)) {
+        set_aside_files_without_crs(without_crs, r, result);
+        without_crs.clear();
+        context.unknown_frame_file.clear();
+      } else if (r.has_frame && !r.frame_source_known && r.delivered) {
+        without_crs.emplace_back(files[fi], r.frame_srs);
+      }
+      detail::merge_file(std::move(r), files[fi], context, result, files_failed, first_failure);
+    }
     if (fi == files.size()) break;
     // Largest first, so that a big file does not start last; at most one task a thread in flight, so
     // memory holds the footprints kept and one reading per thread.
@@ -360,8 +405,11 @@ PipelineResult run(const PipelineOptions& options, const Progress& progress, std
     for (; fi < files.size(); ++fi)
       detail::merge_file(std::move(reads[fi]), files[fi], context, result, files_failed, first_failure);
   }
+  std::sort(result.files_read.begin(), result.files_read.end());
+  result.files_read.erase(std::unique(result.files_read.begin(), result.files_read.end()), result.files_read.end());
   xml::release_cached_blocks();  // the reading threads' spare memory, before the union needs its own
-  if (files_failed == files.size() && result.footprints.empty()) throw InputError(first_failure);
+  if (files_failed == files.size() && result.footprints.empty() && options.unreadable_throws)
+    throw InputError(first_failure);
   result.timings.read_s = std::max(0.0, seconds_since(t_read) - result.timings.footprints_s);
 
   const auto t_union = clock_type::now();

@@ -131,6 +131,7 @@ void PlanSpill::encode(const GroundPlan& plan, const std::vector<const Footprint
     const Footprint& fp = *members[k];
     w.put(plan.members[k]);
     w.str(fp.source_id);
+    w.str(fp.parent_id);
     w.str(fp.source_file);
     w.str(fp.method);
     w.put(fp.min_z);
@@ -197,6 +198,7 @@ SpilledPlan decode(Reader& r, bool polygons) {
     Footprint& fp = s.footprints[k];
     s.ids[k] = r.get<std::uint32_t>();
     fp.source_id = r.str();
+    fp.parent_id = r.str();
     fp.source_file = r.str();
     fp.method = r.str();
     fp.min_z = r.get<double>();

@@ -42,10 +42,12 @@ class SpilledResult final : public TiledResult {
     if (!segments.empty())
       for (std::uint32_t& m : out.plan.members) m += segment(i).id_shift;
     out.member_ids.reserve(s.footprints.size());
+    out.member_buildings.reserve(s.footprints.size());
     for (std::size_t k = 0; k < s.footprints.size(); ++k) {
       const Footprint& fp = s.footprints[k];
       out.min_z = k ? std::min(out.min_z, fp.min_z) : fp.min_z;
       out.max_z = k ? std::max(out.max_z, fp.max_z) : fp.max_z;
+      out.member_buildings.push_back(building_id_of(fp));
       out.member_ids.push_back(fp.source_id);
     }
     return out;
@@ -607,7 +609,7 @@ std::unique_ptr<TiledResult> run_tiled(const PipelineOptions& options, const Pro
     ts.map_s = share.map_s;
     ts.reduce_s = share.reduce_s;
   }
-  if (failed_total == files.size() && footprints_total == 0)
+  if (failed_total == files.size() && footprints_total == 0 && options.unreadable_throws)
     throw InputError(first_failure.empty() ? "no input file could be read" : first_failure);
 
   out->problems = std::move(acc.problems);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "xml/safe_xml.h"
+#include "files_read.h"
 
 #include <groundplan/error.h>
 
@@ -145,6 +146,7 @@ struct VsiFile {
 
 /// Opens `path` after checking its stated size against the budget.
 VsiFile open_bounded(const std::string& path, const std::string& display, const ByteBudget& budget) {
+  gis::note_file_opened(path);  // also when missing: a model added later changes the result
   VSIStatBufL st;
   if (VSIStatExL(path.c_str(), &st, VSI_STAT_EXISTS_FLAG | VSI_STAT_SIZE_FLAG) != 0)
     throw InputError(display + ": cannot open the file (does it exist and is it readable?)");

@@ -224,6 +224,43 @@ TEST(WorkingFrame, UnknownCrsKeepsCoordinatesAndSaysSo) {
   EXPECT_THROW(WorkingFrame("", t), InvalidArgument);
 }
 
+// Heights leave the frame in metres like x and y: a New York file in EPSG:2263 (US survey feet) writes a 118 m
+// roof as 388.49; with a compound CRS the vertical part's unit decides (NAVD88 height (ftUS), EPSG:6360), also
+// under a horizontal CRS in metres; heights of a CRS in metres are kept to the bit.
+TEST(WorkingFrame, HeightsBecomeMetres) {
+  constexpr double kFtUs = 1200.0 / 3937.0;
+  struct Case {
+    const char* srs;
+    double x, y, factor;
+  } cases[] = {
+      {"EPSG:2263", 988000, 210000, kFtUs},
+      {"EPSG:2263+6360", 988000, 210000, kFtUs},
+      {"urn:ogc:def:crs,crs:EPSG::2263,crs:EPSG::6360", 988000, 210000, kFtUs},
+      {"EPSG:32618+6360", 585000, 4512000, kFtUs},
+      {"EPSG:2263+5703", 988000, 210000, 1.0},  // NAVD88 height in metres under a horizontal CRS in feet
+      {"EPSG:25832", 457842, 5439083, 1.0},
+      {"EPSG:25832+5783", 457842, 5439083, 1.0},
+  };
+  for (const Case& c : cases) {
+    WorkingFrame f(c.srs);
+    Mesh m;
+    m.add_face({{{c.x, c.y, 388.49}, {c.x + 30, c.y, 388.49}, {c.x + 30, c.y + 30, 12.5}}}, SurfaceKind::Unknown, 1);
+    ASSERT_TRUE(f.transform(m)) << c.srs;
+    EXPECT_NEAR(m.vertices[0].z, 388.49 * c.factor, 1e-9) << c.srs;
+    EXPECT_NEAR(m.vertices[2].z, 12.5 * c.factor, 1e-9) << c.srs;
+    EXPECT_EQ(f.height_to_metre() == 1.0, c.factor == 1.0) << c.srs;
+    if (c.factor == 1.0) EXPECT_EQ(m.vertices[0].z, 388.49) << c.srs;
+  }
+  // A horizontal CRS in metres with a vertical one in feet: x, y untouched, z converted.
+  WorkingFrame f("EPSG:32618+6360");
+  Mesh m;
+  m.add_face({{{585000.25, 4512000.5, 100}, {585010, 4512000, 100}, {585010, 4512010, 0}}}, SurfaceKind::Unknown, 1);
+  ASSERT_TRUE(f.transform(m));
+  EXPECT_EQ(m.vertices[0].x, 585000.25);
+  EXPECT_EQ(m.vertices[0].y, 4512000.5);
+  EXPECT_EQ(f.working_crs().epsg, 32618);
+}
+
 TEST(WorkingFrame, TargetMustBeProjectedMetric) {
   CrsOptions t;
   t.target_srs = "EPSG:4326";

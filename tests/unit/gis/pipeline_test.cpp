@@ -145,25 +145,59 @@ TEST(Pipeline, CancelStopsTheWork) {
 
 // A folder whose first file has no CRS: its coordinates are kept as written, so a later file with a
 // CRS must not be projected into some UTM zone and mixed with them; it is refused with a problem.
+// A folder of a file without CRS and a georeferenced one: whatever their order, the georeferenced file fixes the
+// working CRS and the other is left out, its buildings and itself each a NO_CRS problem that names the file, the
+// cause and -s_srs. (Before, the first file decided: the CRS-less file first made the georeferenced one fail.)
 TEST(Pipeline, FileWithoutCrsIsNotMixedWithGeoreferencedFiles) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / "groundplan_mixed_crs_test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  fs::copy_file(test::shared_data("citygml1-berlin-lod2-libcitygml/b1_lod2_s.gml"), dir / "a_no_crs.gml");
-  fs::copy_file(test::sample_data("tum-main-entrance/TUM-Main-Entrance.gml"), dir / "b_utm32.gml");
-  gis::PipelineOptions options;
-  options.inputs = {dir.string()};
-  const gis::PipelineResult r = gis::run_pipeline(options);
-  fs::remove_all(dir);
-  EXPECT_TRUE(r.crs_wkt.empty()) << r.crs_name;
-  bool refused = false;
-  for (const auto& p : r.problems)
-    refused |= p.file.find("b_utm32.gml") != std::string::npos && p.stage == "georeference" &&
-               p.reason.find("a_no_crs.gml") != std::string::npos;
-  EXPECT_TRUE(refused) << "no problem names the mix";
-  for (const auto& f : r.footprints) EXPECT_EQ(f.source_file.find("b_utm32.gml"), std::string::npos) << f.source_id;
-  ASSERT_FALSE(r.footprints.empty());
+  struct Outcome {
+    std::string crs;
+    std::vector<std::string> footprints, no_crs;
+  };
+  auto run_with = [](const std::string& no_crs_name, const std::string& utm_name) {
+    const fs::path dir = fs::temp_directory_path() / "groundplan_mixed_crs_test";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy_file(test::shared_data("citygml1-berlin-lod2-libcitygml/b1_lod2_s.gml"), dir / no_crs_name);
+    fs::copy_file(test::sample_data("tum-main-entrance/TUM-Main-Entrance.gml"), dir / utm_name);
+    gis::PipelineOptions options;
+    options.inputs = {dir.string()};
+    const gis::PipelineResult r = gis::run_pipeline(options);
+    fs::remove_all(dir);
+    Outcome o;
+    o.crs = r.crs_name;
+    for (const auto& f : r.footprints) {
+      EXPECT_NE(f.source_file.find(utm_name), std::string::npos) << f.source_id;
+      o.footprints.push_back(f.source_id);
+    }
+    bool file_problem = false;
+    for (const auto& p : r.problems) {
+      if (p.code != "NO_CRS") continue;
+      EXPECT_NE(p.file.find(no_crs_name), std::string::npos) << p.reason;
+      if (p.source_id.empty()) {
+        file_problem = true;
+        EXPECT_NE(p.reason.find(no_crs_name), std::string::npos) << p.reason;
+        EXPECT_NE(p.reason.find("no srsName"), std::string::npos) << p.reason;
+        EXPECT_NE(p.reason.find("-s_srs"), std::string::npos) << p.reason;
+      } else {
+        o.no_crs.push_back(p.source_id);
+      }
+      EXPECT_EQ(p.reason.find("target CRS"), std::string::npos) << p.reason;
+    }
+    EXPECT_TRUE(file_problem) << "no problem names the file without CRS";
+    EXPECT_EQ(r.buildings_read, r.footprints.size() + r.buildings_dropped);
+    std::sort(o.footprints.begin(), o.footprints.end());
+    std::sort(o.no_crs.begin(), o.no_crs.end());
+    return o;
+  };
+  const Outcome first = run_with("a_no_crs.gml", "b_utm32.gml");  // the file without CRS read first
+  const Outcome last = run_with("b_no_crs.gml", "a_utm32.gml");   // ... and last
+  EXPECT_EQ(first.crs, "EPSG:25832");
+  EXPECT_EQ(last.crs, first.crs);
+  ASSERT_FALSE(first.footprints.empty());
+  EXPECT_EQ(last.footprints, first.footprints);
+  ASSERT_FALSE(first.no_crs.empty());
+  EXPECT_EQ(last.no_crs, first.no_crs);
 }
 
 }  // namespace

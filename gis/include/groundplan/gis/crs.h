@@ -3,7 +3,9 @@
 // srsName parsing and the working frame (DESIGN.md stage 2, issue 6). The working CRS is projected
 // and metric: the source's horizontal CRS when it is, else the WGS 84 UTM zone of the data's centre
 // (EPSG:326xx / 327xx), or what the user names (-t_srs). Meshes are transformed in place: x, y
-// become easting, northing in metres; z is kept as written.
+// become easting, northing in metres; z becomes metres too (its datum kept): the unit of the source's
+// vertical CRS where it names one (compound "EPSG:2263+6360": NAVD88 height in US survey feet), else of its
+// horizontal CRS when projected (EPSG:2263 alone: feet), else metres (ellipsoidal heights).
 //
 // Axis order: a geographic source is read in its authority order (EPSG:4326, 4979, 6697 ... write
 // latitude first, as CityGML files must: "35.7559 139.5542 55.03" is lat, lon, h); a projected source
@@ -94,7 +96,8 @@ class WorkingFrame {
 
   bool source_known() const;            // false: no or local srsName; coordinates pass unchanged
   bool source_geographic() const;
-  bool identity() const;                // nothing to do (projected metric source, no target)
+  bool identity() const;                // nothing to do (projected metric source in metres, no target)
+  double height_to_metre() const;       // what transform() multiplies z by (1: heights in metres already)
   const SrsName& source() const;
   const WorkingCrs& working_crs() const;  // valid after decide() (or at once when no choice is needed)
   /// Things a person should know (CRS unknown, axis order guessed ...): one sentence each.

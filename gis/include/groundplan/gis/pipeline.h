@@ -48,6 +48,9 @@ struct PipelineOptions {
   /// meanwhile). Not called with a level of detail, whose steps change the union's plans. Empty, or null returned:
   /// none.
   std::function<PlanFeed*(const PipelineResult& read)> plan_feed;
+  /// No input could be read at all: true throws InputError (the first file's fault); false returns the result,
+  /// without footprints, its problems naming every file's fault (the CLI, to write the problems layer asked for).
+  bool unreadable_throws = true;
 };
 
 /// How the inputs were read (--stats "reading").
@@ -90,15 +93,23 @@ struct PipelineResult {
   std::string raster_backend;         // "cpu" or "cuda"
   std::string crs_wkt;                // working CRS (WKT2), empty when the input has no CRS
   std::string crs_name;               // e.g. "EPSG:25833", for messages
+  /// The files the readers opened, sorted, each once: the input files and what they link (a KML's COLLADA models
+  /// and NetworkLinks, a glTF's buffers, an OGR source's files). The driver's result cache keys on them.
+  std::vector<std::string> files_read;
   StageTimings timings;
   LodStats lod_stats;                 // what the level-of-detail steps changed (all zero when off)
   ReadStats reading;
 };
 
 /// Runs read -> footprints -> union. Throws InputError when no input can be read at all (every file
-/// unreadable and no footprint from any: a truncated file still gives the buildings before the cut), Cancelled
+/// unreadable and no footprint from any: a truncated file still gives the buildings before the cut; unless
+/// options.unreadable_throws is false), Cancelled
 /// when `progress` asks to stop. A bad building is a Problem, not an exception.
 PipelineResult run_pipeline(const PipelineOptions& options, const Progress& progress = {});
+
+/// The files `inputs` name (a folder: its input files, sorted by name; a .zip: its city files), as run_pipeline
+/// reads them. Throws InputError for a missing input or a folder without input files.
+std::vector<std::string> input_files(const std::vector<std::string>& inputs);
 
 /// The inputs a source names as users write it, in the CLI and after `GROUNDPLAN:`: one file or folder, or
 /// several separated by commas (a path that exists as written is one input, commas and all; double quotes keep

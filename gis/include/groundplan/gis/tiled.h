@@ -20,6 +20,7 @@ namespace groundplan::gis {
 struct StoredPlan {
   GroundPlan plan;                      // members: global footprint indices, ascending
   std::vector<std::string> member_ids;  // source_id of each member, same order
+  std::vector<std::string> member_buildings;  // the Building of each member (building_id_of), same order
   double min_z = 0, max_z = 0;          // over the members
 };
 
