@@ -669,6 +669,7 @@ std::string guess_working_definition(const std::string& file, const PipelineOpti
   if (info.in_working_crs || !placer.frame || !placer.frame->source_known() || !placer.frame->decided()) return {};
   const WorkingCrs& crs = placer.frame->working_crs();
   return crs.known ? crs.definition : std::string{};
+}
 
 std::string no_crs_cause(const std::string& srs) {
   const SrsName name = parse_srs_name(srs);
