@@ -42,10 +42,20 @@ struct Poly {
   bool has_area;
 };
 
+/// What a walk vertex is exactly, for snap rounding: the segment ending at it lies on the line a->b (the input
+/// edge walked, in the walk's direction), and a crossing point is where that line meets the line f0->f1.
+struct ExactVertex {
+  Point2 a, b, f0, f1;
+  bool cross;
+};
+
 struct RingOut {
   std::vector<Point2> pts;
   bool rounded = false;  // some vertex is a rounded crossing point (else every vertex is exact input)
   std::vector<std::uint32_t> polys;  // polygons whose area borders this ring
+  // Per vertex of pts, what it is exactly; filled for rounded walks only (the others are exact as they are).
+  // A rounded walk without it is taken as its rounded points (snap_round's unit tests).
+  std::vector<ExactVertex> exact;
 };
 
 inline int sgn_diff(double a, double b) { return (a > b) - (a < b); }

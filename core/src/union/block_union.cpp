@@ -514,6 +514,7 @@ void BlockEngine::walk_ring(std::uint32_t e, bool forward) {
   }
   ring.polys.push_back(edges_[e].poly);
   stats_.walk_steps += end - first;
+  if (!ring.rounded) std::vector<ExactVertex>().swap(ring.exact);  // exact as they are
   ++stats_.rings_traced;
   rings_.push_back(std::move(ring));
 }
@@ -801,6 +802,8 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     // (the ring touches itself there); split_simple needs to see it, then drops straight vertices
     ring.pts.push_back(point_of(L, x0));
     ring.rounded |= x0.cross;
+    ring.exact.push_back(ExactVertex{L.a, L.b, x0.cross ? edges_[x0.f].p0 : Point2{}, x0.cross ? edges_[x0.f].p1 : Point2{},
+                                     x0.cross});
     group.assign(rays.begin() + static_cast<std::ptrdiff_t>(g0), rays.begin() + static_cast<std::ptrdiff_t>(g1));
     L = Line(out.edge, out.from, out.to);
     cur = next;
@@ -809,6 +812,7 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
         cmp(L0, cur, start0) == 0)
       break;
   }
+  if (!ring.rounded) std::vector<ExactVertex>().swap(ring.exact);  // exact as they are
   ++stats_.rings_traced;
   rings_.push_back(std::move(ring));
 }

@@ -2,8 +2,12 @@
 // Snap rounding of one block's boundary (see snap_round.h and docs/union_engine.md).
 //
 // Pixels are half-open squares [i g, (i+1) g) x [j g, (j+1) g) of the grid of pitch g (a power of
-// two); a pixel is hot when it holds a vertex of a walk or a crossing of two walk segments (rounded
-// walks can cross where the exact ones only touch). Every segment is replaced by the polyline through
+// two); a pixel is hot when it holds a vertex of a walk. The segments rounded are the EXACT walk
+// segments: a crossing point is taken where it is exactly (its pixel, and the input edge it lies on),
+// not where it is rounded to, because rounded crossings can turn a face of the boundary over (a
+// sub-ulp wedge: two rounded walk segments crossing where the exact ones do not), and snap rounding
+// keeps what it is given: an edge with union on the left twice. The exact walks of a union do not
+// cross, so no crossing makes a pixel hot. Every segment is replaced by the polyline through
 // the centres of the hot pixels it meets, in order along it; each piece of that polyline is rerouted
 // again while it meets a hot pixel other than its two ends (iterated snap rounding), so that no
 // output vertex is closer than g/2 to an output edge it is not on. All tests are exact: a segment
@@ -67,6 +71,27 @@ class SnapRounder {
   void add_hot(const Pix& p) {
     if (index_.emplace(p, static_cast<std::uint32_t>(hot_.size())).second) hot_.push_back(p);
   }
+  /// The pixel of a walk vertex, exactly: a crossing point is correctly rounded to `r`, and rounding is
+  /// monotone and pixel sides are doubles, so the exact point is in r's pixel unless r lies on the pixel's
+  /// left (bottom) side and the exact point left of (below) it.
+  Pix exact_pixel(const Point2& r, const ExactVertex* ex) const {
+    Pix p = pixel_of(r);
+    if (!ex || !ex->cross) return p;
+    if (r.x == static_cast<double>(p.i) * g_ && exact_before(*ex, r.x, true)) --p.i;
+    if (r.y == static_cast<double>(p.j) * g_ && exact_before(*ex, r.y, false)) --p.j;
+    return p;
+  }
+  /// Whether the crossing of lines a->b and f0->f1 has x < v (`x`), else y < v; exact (compare_crossings
+  /// with the grid line x = v or y = v).
+  static bool exact_before(const ExactVertex& ex, double v, bool x) {
+    const double a = x ? ex.a.x : ex.a.y, b = x ? ex.b.x : ex.b.y;
+    const double f0 = x ? ex.f0.x : ex.f0.y, f1 = x ? ex.f1.x : ex.f1.y;
+    if (a == b) return a < v;  // the crossing is on this axis-parallel line
+    if (f0 == f1) return f0 < v;
+    const Point2 g0 = x ? Point2{v, 0} : Point2{0, v}, g1 = x ? Point2{v, 1} : Point2{1, v};
+    // sign of t_f - t_g along a->b, times the direction of the coordinate along a->b
+    return robust::compare_crossings(ex.a, ex.b, ex.f0, ex.f1, g0, g1) * sgn_diff(b, a) < 0;
+  }
   /// The hot pixels of a crossing point rounded to nearest: the exact point is within half an ulp,
   /// so its pixel is that of the rounded point or of a neighbouring double (more hot pixels than
   /// needed is harmless; fewer would not be).
@@ -83,6 +108,12 @@ class SnapRounder {
     const double y0 = static_cast<double>(p.j) * g_, y1 = static_cast<double>(p.j + 1) * g_;
     if (std::max(a.x, b.x) < x0 || std::min(a.x, b.x) >= x1 || std::max(a.y, b.y) < y0 || std::min(a.y, b.y) >= y1)
       return false;
+    return line_meets(a, b, p);
+  }
+  /// Exact: does the line through a and b meet the half-open pixel p?
+  bool line_meets(const Point2& a, const Point2& b, const Pix& p) const {
+    const double x0 = static_cast<double>(p.i) * g_, x1 = static_cast<double>(p.i + 1) * g_;
+    const double y0 = static_cast<double>(p.j) * g_, y1 = static_cast<double>(p.j + 1) * g_;
     // corners shifted by (-eps, -eps): where a corner is on the line, the side is -sign((b-a) x (1,1))
     const int tie = -cross_sign(a, b, Point2{0, 0}, Point2{1, 1});
     bool pos = false, neg = false;
@@ -113,12 +144,45 @@ class SnapRounder {
     });
   }
 
+  /// The hot pixels met by the segment on the line a->b from a point in pixel P to a point in pixel Q
+  /// (both hot), ordered along a->b. Exact for exact points anywhere on the line: along a monotone line
+  /// the pixels it meets form a staircase on which sx*i + sy*j increases strictly, and the segment's
+  /// pixels are those of the staircase from P to Q.
+  void route_on_line(const Point2& a, const Point2& b, const Pix& P, const Pix& Q, std::vector<std::uint32_t>& out) {
+    out.clear();
+    const std::uint32_t hp = index_.at(P), hq = index_.at(Q);
+    out.push_back(hp);
+    if (P == Q) return;
+    const std::int64_t sx = sgn_diff(b.x, a.x), sy = sgn_diff(b.y, a.y);
+    const auto key = [&](const Pix& p) { return sx * p.i + sy * p.j; };
+    const std::int64_t kp = key(P), kq = key(Q);
+    Box q;
+    q.minx = static_cast<double>(std::min(P.i, Q.i)) * g_;
+    q.maxx = static_cast<double>(std::max(P.i, Q.i) + 1) * g_;
+    q.miny = static_cast<double>(std::min(P.j, Q.j)) * g_;
+    q.maxy = static_cast<double>(std::max(P.j, Q.j) + 1) * g_;
+    hot_grid_.query(q, [&](std::uint32_t h) {
+      const Pix& p = hot_[h];
+      if (h == hp || h == hq || p.i < std::min(P.i, Q.i) || p.i > std::max(P.i, Q.i) || p.j < std::min(P.j, Q.j) ||
+          p.j > std::max(P.j, Q.j))
+        return;
+      const std::int64_t k = key(p);
+      if (k > kp && k < kq && line_meets(a, b, p)) out.push_back(h);
+    });
+    out.push_back(hq);
+    std::sort(out.begin() + 1, out.end() - 1,
+              [&](std::uint32_t u, std::uint32_t v) { return key(hot_[u]) < key(hot_[v]); });
+  }
+
   bool run(const std::vector<RingOut>& walks, std::vector<SnappedRing>& out, SnapStats& stats);
 
  private:
   struct Seg {
-    Point2 a, b;
+    Point2 a, b;      // the rounded points (ends of the segment as output where kept)
+    Point2 la, lb;    // the exact segment lies on the line la->lb, from a point in pixel pa to one in pb
+    Pix pa, pb;
     std::uint32_t walk;
+    bool exact;       // false: a rounded walk given without its exact vertices (taken as rounded)
   };
   struct GEdge {
     std::uint32_t u, v, walk;
@@ -132,20 +196,31 @@ class SnapRounder {
 bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing>& out, SnapStats& stats) {
   // 1. segments of the walks; their vertices make hot pixels
   std::vector<Seg> segs;
+  std::vector<std::vector<Pix>> vpix(walks.size());  // the exact pixel of every walk vertex
   Box all;
   for (std::uint32_t w = 0; w < walks.size(); ++w) {
-    std::vector<Point2> pts;
-    for (const Point2& p : walks[w].pts)
-      if (pts.empty() || !(pts.back() == p)) pts.push_back(p);
-    while (pts.size() > 1 && pts.front() == pts.back()) pts.pop_back();
-    for (std::size_t k = 0; k < pts.size(); ++k) {
-      add_hot(pixel_of(pts[k]));
-      all.add(pts[k]);
-      if (pts.size() > 1) segs.push_back({pts[k], pts[(k + 1) % pts.size()], w});
+    const RingOut& W = walks[w];
+    const bool exact = W.exact.size() == W.pts.size();
+    const std::size_t n = W.pts.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      vpix[w].push_back(exact_pixel(W.pts[k], exact ? &W.exact[k] : nullptr));
+      add_hot(vpix[w].back());
+      all.add(W.pts[k]);
+    }
+    // the segment ending at vertex k lies on exact[k]'s line (for a walk without them: its own points)
+    for (std::size_t k = 0; k < n && n > 1; ++k) {
+      const std::size_t k1 = (k + 1) % n;
+      if (vpix[w][k] == vpix[w][k1]) continue;  // within one pixel: no grid edge
+      const Point2 &a = W.pts[k], &b = W.pts[k1];
+      if (exact)
+        segs.push_back({a, b, W.exact[k1].a, W.exact[k1].b, vpix[w][k], vpix[w][k1], w, true});
+      else
+        segs.push_back({a, b, a, b, vpix[w][k], vpix[w][k1], w, !W.rounded});
     }
   }
   if (segs.empty()) return true;
-  // 2. crossings of rounded segments make hot pixels (exact orientation; the point correctly rounded)
+  // 2. crossings of rounded segments make hot pixels (exact orientation; the point correctly rounded): only
+  // where a walk is given as rounded points alone; exact walk segments do not cross
   {
     std::vector<Box> boxes(segs.size());
     for (std::size_t s = 0; s < segs.size(); ++s) {
@@ -157,7 +232,7 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
     for (std::uint32_t s = 0; s < segs.size(); ++s) {
       const Seg& S = segs[s];
       sg.query(boxes[s], [&](std::uint32_t t) {
-        if (t <= s || !boxes[s].overlaps(boxes[t])) return;
+        if (t <= s || !boxes[s].overlaps(boxes[t]) || (S.exact && segs[t].exact)) return;
         const Seg& T = segs[t];
         const int o1 = orient(S.a, S.b, T.a), o2 = orient(S.a, S.b, T.b);
         if (o1 * o2 >= 0) return;
@@ -184,7 +259,7 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
   std::vector<std::pair<std::uint32_t, std::uint32_t>> stack;
   std::size_t budget = 64 * segs.size() + 100000;
   for (const Seg& S : segs) {
-    route(S.a, S.b, path);
+    route_on_line(S.la, S.lb, S.pa, S.pb, path);
     for (std::size_t k = 0; k + 1 < path.size(); ++k) stack.emplace_back(path[k], path[k + 1]);
     while (!stack.empty()) {
       if (budget-- == 0) return false;
@@ -263,9 +338,10 @@ bool SnapRounder::run(const std::vector<RingOut>& walks, std::vector<SnappedRing
   // edge it is not on); if that fails, every vertex goes to its centre (plain ISR, valid by construction).
   std::vector<Point2> rep(hot_.size());
   std::vector<std::uint8_t> state(hot_.size(), 0);  // 0 no walk vertex, 1 one walk vertex, 2 more
-  for (const RingOut& w : walks)
-    for (std::size_t k = 0; k < w.pts.size(); ++k) {
-      const std::uint32_t h = index_.at(pixel_of(w.pts[k]));
+  for (std::uint32_t wi = 0; wi < walks.size(); ++wi)
+    for (std::size_t k = 0; k < walks[wi].pts.size(); ++k) {
+      const RingOut& w = walks[wi];
+      const std::uint32_t h = index_.at(vpix[wi][k]);
       if (state[h] == 0) {
         state[h] = 1;
         rep[h] = w.pts[k];

@@ -3,7 +3,8 @@
 // Snap rounding of one block's boundary (issue 20; docs/union_engine.md, "Snap rounding").
 // The engine's walks are exact up to their crossing points, each correctly rounded to doubles.
 // Rounded, two walks may cross, overlap by a sliver or pass within an ulp of each other. This stage
-// makes the output consistent: iterated snap rounding (ISR, Halperin & Packer) of the walks' segments
+// makes the output consistent: iterated snap rounding (ISR, Halperin & Packer) of the walks' exact
+// segments (RingOut::exact: the input edge each lies on, the exact pixel of each crossing)
 // on one grid of pitch g for the whole call, cancellation of opposite coincident grid edges, and
 // rings linked by the engine's minimal-ring rule.
 #include <cstdint>
