@@ -264,6 +264,7 @@ class BlockEngine {
   std::vector<Point2> load_ring_;
   mutable std::vector<std::pair<int, Ray>> sort_scratch_;
   std::vector<Ray> walk_rays_;
+  std::vector<ExactVertex> walk_exact_;  // what each vertex of the current walk is; kept if it is rounded
   std::vector<robust::Segment> walk_segs_;
   std::vector<std::uint32_t> walk_seg_edges_, poly_hits_;
   std::vector<Cand> chk_cands_, chk_wcands_;
@@ -514,7 +515,6 @@ void BlockEngine::walk_ring(std::uint32_t e, bool forward) {
   }
   ring.polys.push_back(edges_[e].poly);
   stats_.walk_steps += end - first;
-  if (!ring.rounded) std::vector<ExactVertex>().swap(ring.exact);  // exact as they are
   ++stats_.rings_traced;
   rings_.push_back(std::move(ring));
 }
@@ -734,6 +734,8 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
   std::vector<Ray>& rays = walk_rays_;
   std::vector<robust::Segment>& segs = walk_segs_;
   std::vector<std::uint32_t>& seg_edges = walk_seg_edges_;
+  std::vector<ExactVertex>& exact = walk_exact_;
+  exact.clear();
   std::uint32_t scanned_edge = kNone;
   Point2 scanned_from;
   for (std::size_t step = 0;; ++step) {
@@ -802,8 +804,8 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
     // (the ring touches itself there); split_simple needs to see it, then drops straight vertices
     ring.pts.push_back(point_of(L, x0));
     ring.rounded |= x0.cross;
-    ring.exact.push_back(ExactVertex{L.a, L.b, x0.cross ? edges_[x0.f].p0 : Point2{}, x0.cross ? edges_[x0.f].p1 : Point2{},
-                                     x0.cross});
+    exact.push_back(ExactVertex{L.a, L.b, x0.cross ? edges_[x0.f].p0 : Point2{}, x0.cross ? edges_[x0.f].p1 : Point2{},
+                                x0.cross});
     group.assign(rays.begin() + static_cast<std::ptrdiff_t>(g0), rays.begin() + static_cast<std::ptrdiff_t>(g1));
     L = Line(out.edge, out.from, out.to);
     cur = next;
@@ -812,7 +814,7 @@ void BlockEngine::walk(Line L, Event start, std::vector<Ray> group) {
         cmp(L0, cur, start0) == 0)
       break;
   }
-  if (!ring.rounded) std::vector<ExactVertex>().swap(ring.exact);  // exact as they are
+  if (ring.rounded) ring.exact = exact;  // the others are exact as they are
   ++stats_.rings_traced;
   rings_.push_back(std::move(ring));
 }
