@@ -277,18 +277,72 @@ TEST(Tiles3d, AddTakesEveryLevel) {
   expect_plans_of_citygml(r, kFloat32Tolerance, "add");
 }
 
-TEST(Tiles3d, TheSameBuildingInTwoContentsIsSaid) {
-  // ADD with the whole city in the parent and the west half again in the child: the west buildings come
-  // twice (ADD means both levels), and each repeat is a DUPLICATE_ID problem naming the building.
+/// The mean of a mesh's vertices in plan.
+Point2 centre(const Mesh& m) {
+  Point2 c{0, 0};
+  for (const Point3& v : m.vertices) c = Point2{c.x + v.x / m.vertices.size(), c.y + v.y / m.vertices.size()};
+  return c;
+}
+
+TEST(Tiles3d, AddCountsEachBuildingOnceTheFinerCopy) {
+  // ADD with the whole city in the parent and the west half again in the child, moved 5 km east by the
+  // child's transform so that the two copies differ: every building once, the west ones from the child
+  // (the finer level), each coarser copy left out in a NOTE naming the building and both tiles.
   test::TempDir d("gp_3dtiles");
   d.file("all.b3dm", slurp(tiles("levels/all.b3dm")));
   d.file("west.b3dm", slurp(tiles("levels/west.b3dm")));
   nlohmann::json ts = nlohmann::json::parse(slurp(tiles("levels/add.json")));
   ts["root"]["content"]["uri"] = "all.b3dm";
   ts["root"]["children"][0]["content"]["uri"] = "west.b3dm";
-  const test::Read r = test::read(d.file("add.json", ts.dump()));
-  EXPECT_EQ(r.meshes.size(), kBuildings + 40);
+  ts["root"]["children"][0]["transform"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5000, 0, 0, 1};
+  gis::ReadOptions opt;
+  opt.target_srs = "EPSG:25832";
+  const test::Read r = test::read(d.file("add.json", ts.dump()), opt);
+  ts["root"].erase("children");
+  const test::Read parent = test::read(d.file("parent.json", ts.dump()), opt);
+  ASSERT_EQ(parent.meshes.size(), kBuildings) << parent.all();
+
+  std::map<std::string, Point2> coarse, kept;
+  for (const Mesh& m : parent.meshes) coarse[m.source_id] = centre(m);
+  for (const Mesh& m : r.meshes) EXPECT_TRUE(kept.emplace(m.source_id, centre(m)).second) << m.source_id << " twice";
+  EXPECT_EQ(r.meshes.size(), kBuildings) << r.all();
+  std::set<std::string> kept_ids;
+  for (const auto& [id, c] : kept) kept_ids.insert(id);
+  EXPECT_EQ(kept_ids, building_ids());
+  std::size_t moved = 0;
+  for (const auto& [id, c] : kept) {
+    const double east = c.x - coarse.at(id).x;
+    EXPECT_TRUE(std::abs(east) < 1 || std::abs(east - 5000) < 50) << id << " moved " << east << " m";
+    moved += std::abs(east - 5000) < 50;
+  }
+  EXPECT_EQ(moved, 40u) << "the west buildings are the child's copies";
+  EXPECT_EQ(r.count("DUPLICATE_ID"), 0u) << r.all();
+  EXPECT_EQ(r.info.tiles3d.coarser_copies_left_out, 40u);
+  std::size_t notes = 0;
+  for (const Problem& p : r.problems)
+    if (p.code == "NOTE" && p.reason.find("coarser one is left out") != std::string::npos) {
+      ++notes;
+      EXPECT_NE(p.file.find("all.b3dm"), std::string::npos) << p.file;
+      EXPECT_NE(p.reason.find("\"" + p.source_id + "\""), std::string::npos) << p.reason;
+      EXPECT_NE(p.reason.find("west.b3dm"), std::string::npos) << p.reason;
+      EXPECT_NEAR(kept.at(p.source_id).x - coarse.at(p.source_id).x, 5000, 50) << p.source_id;
+    }
+  EXPECT_EQ(notes, 40u) << r.all();
+}
+
+TEST(Tiles3d, TheSameBuildingInTwoNeighbouringTilesIsSaid) {
+  // Two sibling tiles holding the same buildings (a building cut between tiles looks so): neither is finer,
+  // both copies are read and each repeat is a DUPLICATE_ID problem naming the building.
+  test::TempDir d("gp_3dtiles");
+  d.file("west.b3dm", slurp(tiles("levels/west.b3dm")));
+  d.file("again.b3dm", slurp(tiles("levels/west.b3dm")));
+  nlohmann::json ts = nlohmann::json::parse(slurp(tiles("levels/replace.json")));
+  ts["root"]["children"][0]["content"]["uri"] = "west.b3dm";
+  ts["root"]["children"][1]["content"]["uri"] = "again.b3dm";
+  const test::Read r = test::read(d.file("siblings.json", ts.dump()));
+  EXPECT_EQ(r.meshes.size(), 80u);
   EXPECT_EQ(r.count("DUPLICATE_ID"), 40u) << r.all();
+  EXPECT_EQ(r.info.tiles3d.coarser_copies_left_out, 0u);
   for (const Problem& p : r.problems)
     if (p.code == "DUPLICATE_ID") {
       EXPECT_NE(p.reason.find(p.source_id), std::string::npos) << p.reason;
