@@ -264,6 +264,9 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   if (!fp.polygons.empty()) {
     res.ok = true;
     res.method = FootprintMethod::SolidBottom;
+    // Chosen among the lowest horizontal faces by their turn: those left out must lie over the chosen ones.
+    const footprint::GroundCheck g = footprint::check_ground(mesh, fp.polygons, params);
+    if (g.misses_ground()) res.misses_ground = g.reason();
     return res;
   }
 
