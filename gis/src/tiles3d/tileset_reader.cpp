@@ -157,19 +157,21 @@ class Walker {
       // copy is the one read, as "the finest level" says, and this coarser one is left out, said in a NOTE.
       // Anywhere else (two contents of one tile, a building cut between neighbouring tiles) the two copies
       // may be different pieces of the building: both are read, and said, as CityGML's repeated gml:id is.
-      auto [at, fresh] = delivered_.emplace(mesh.source_id, Delivered{d.file, d.path, deliveries_});
-      if (!fresh && is_ancestor(d.path, at->second.path)) {
+      std::vector<Delivered>& earlier = delivered_[mesh.source_id];
+      const auto finer = std::find_if(earlier.begin(), earlier.end(), [&](const Delivered& e) { return is_ancestor(d.path, e.path); });
+      if (finer != earlier.end()) {
         problems_.push_back(Problem{mesh.source_id, d.file, "read", "NOTE",
-                                    "building id \"" + mesh.source_id + "\" is also in " + at->second.file +
+                                    "building id \"" + mesh.source_id + "\" is also in " + finer->file +
                                         ", a tile below this one (a finer level of detail): that copy is read, this "
                                         "coarser one is left out"});
         ++info_.coarser_copies_left_out;
         continue;
       }
-      if (!fresh && at->second.delivery != deliveries_)  // (one content may repeat an id: glTF nodes alike named)
+      if (!earlier.empty() && earlier.front().delivery != deliveries_)  // (one content may repeat an id: glTF nodes)
         problems_.push_back(Problem{mesh.source_id, d.file, "read", "DUPLICATE_ID",
-                                    "building id \"" + mesh.source_id + "\" is also in " + at->second.file +
+                                    "building id \"" + mesh.source_id + "\" is also in " + earlier.front().file +
                                         " (two contents of one tile, or a building cut between tiles): both are read"});
+      if (earlier.empty() || earlier.back().delivery != deliveries_) earlier.push_back(Delivered{d.file, d.path, deliveries_});
       cb_(std::move(mesh), frame);
     }
     d.meshes.clear();
@@ -422,7 +424,7 @@ class Walker {
     std::size_t delivery;  // which content delivered (deliveries_ then)
   };
   std::size_t deliveries_ = 0;
-  std::unordered_map<std::string, Delivered> delivered_;  // building id -> the content that gave it first
+  std::unordered_map<std::string, std::vector<Delivered>> delivered_;  // building id -> the contents that gave it
 };
 
 }  // namespace

@@ -401,6 +401,40 @@ TEST(Tiles3d, TheSameBuildingInTwoNeighbouringTilesIsSaid) {
     }
 }
 
+TEST(Tiles3d, ACoarserCopyIsLeftOutWhateverElseGaveTheBuilding) {
+  // ADD: tile A (west) with child A1 (west again), and in another branch B2, three levels down (west again).
+  // Deepest first: B2, A1 (not below B2's tile: both read, DUPLICATE_ID), then A, above A1: left out.
+  test::TempDir d("gp_3dtiles");
+  for (const char* name : {"a.b3dm", "a1.b3dm", "b2.b3dm"}) d.file(name, slurp(tiles("levels/west.b3dm")));
+  nlohmann::json ts = nlohmann::json::parse(slurp(tiles("levels/replace.json")));
+  ts["root"]["refine"] = "ADD";
+  ts["root"].erase("content");
+  const nlohmann::json leaf = ts["root"]["children"][0];  // bounding volume, geometricError 0, a content
+  auto tile = [&](const char* uri, nlohmann::json children) {
+    nlohmann::json t = leaf;
+    t["geometricError"] = 1;
+    if (uri) t["content"]["uri"] = uri;
+    else t.erase("content");
+    t["children"] = std::move(children);
+    return t;
+  };
+  nlohmann::json a1 = leaf, b2 = leaf;
+  a1["content"]["uri"] = "a1.b3dm";
+  b2["content"]["uri"] = "b2.b3dm";
+  ts["root"]["children"] = {tile("a.b3dm", {a1}), tile(nullptr, {tile(nullptr, {b2})})};
+  const test::Read r = test::read(d.file("branches.json", ts.dump()));
+  EXPECT_EQ(r.meshes.size(), 80u) << r.all();
+  EXPECT_EQ(r.count("DUPLICATE_ID"), 40u) << r.all();
+  EXPECT_EQ(r.info.tiles3d.coarser_copies_left_out, 40u) << r.all();
+  for (const Problem& p : r.problems) {
+    if (p.code == "DUPLICATE_ID") EXPECT_NE(p.file.find("a1.b3dm"), std::string::npos) << p.file;
+    if (p.code == "NOTE" && p.reason.find("left out") != std::string::npos) {
+      EXPECT_NE(p.file.find("a.b3dm"), std::string::npos) << p.file;
+      EXPECT_NE(p.reason.find("a1.b3dm"), std::string::npos) << p.reason;
+    }
+  }
+}
+
 TEST(Tiles3d, GeometricErrorChoosesTheLevel) {
   // The parent's geometricError is 500: allowing 600 m stops there (all.b3dm), 100 m goes down to the leaves.
   CPLSetConfigOption("GROUNDPLAN_3DTILES_GEOMETRIC_ERROR", "600");
