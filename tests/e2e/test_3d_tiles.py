@@ -25,3 +25,18 @@ def test_docs_commands_and_driver(tmp_path):
         footprints = ds.GetLayerByName("footprints")
         ids = {f.GetField("source_id") for f in footprints}
         assert len(ids) == 80 and all(i.startswith("DENILD") for i in ids), sorted(ids)[:5]
+
+
+def test_quantized_glb_keeps_the_lossless_copys_ground(tmp_path):
+    # The same 80 buildings with positions quantized to 16 bits (steps of at most 3.1 cm) and lossless: the
+    # plans' areas agree within a band of half a step in 3D (2.7 cm) along the lossless plans' boundaries.
+    areas, perimeters = {}, {}
+    for name in ("quantized", "nodes"):
+        out = tmp_path / f"{name}.gpkg"
+        p = run([BIN, "-f", "GPKG", out, TILES / "meshopt" / f"{name}.json"])
+        assert " 0 problems" in p.stdout + p.stderr, p.stdout + p.stderr
+        ds = gdal.OpenEx(str(out), gdal.OF_VECTOR)
+        plans = [f.GetGeometryRef().Clone() for f in ds.GetLayerByName("ground_plans")]
+        areas[name] = sum(g.GetArea() for g in plans)
+        perimeters[name] = sum(g.Boundary().Length() for g in plans)
+    assert abs(areas["quantized"] - areas["nodes"]) <= perimeters["nodes"] * 0.5 * 0.031 * 3 ** 0.5, areas
