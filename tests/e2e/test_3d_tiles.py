@@ -43,3 +43,17 @@ def test_folder_with_a_tileset_reads_the_city_files_beside_it(tmp_path):
     counts = s["counts"]
     assert s["reading"]["files"] == 2, said
     assert counts["footprints"] > 80, (counts, said)
+
+def test_quantized_glb_keeps_the_lossless_copys_ground(tmp_path):
+    # The same 80 buildings with positions quantized to 16 bits (steps of at most 3.1 cm) and lossless: the
+    # plans' areas agree within a band of half a step in 3D (2.7 cm) along the lossless plans' boundaries.
+    areas, perimeters = {}, {}
+    for name in ("quantized", "nodes"):
+        out = tmp_path / f"{name}.gpkg"
+        p = run([BIN, "-f", "GPKG", out, TILES / "meshopt" / f"{name}.json"])
+        assert " 0 problems" in p.stdout + p.stderr, p.stdout + p.stderr
+        ds = gdal.OpenEx(str(out), gdal.OF_VECTOR)
+        plans = [f.GetGeometryRef().Clone() for f in ds.GetLayerByName("ground_plans")]
+        areas[name] = sum(g.GetArea() for g in plans)
+        perimeters[name] = sum(g.Boundary().Length() for g in plans)
+    assert abs(areas["quantized"] - areas["nodes"]) <= perimeters["nodes"] * 0.5 * 0.031 * 3 ** 0.5, areas
