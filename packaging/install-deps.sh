@@ -4,8 +4,8 @@
 set -euo pipefail
 
 packages=(
-  # toolchain
-  build-essential cmake ninja-build pkg-config
+  # toolchain; ccache: CI's three builds (Release, sanitizers, fuzz) compile only what changed since the last run
+  build-essential cmake ninja-build pkg-config ccache
   # GIS stack: GDAL (OGR driver, ogr2ogr parser, output formats), GEOS (reference union),
   # PROJ (coordinate systems), GeographicLib (local frames of KML/COLLADA models)
   libgdal-dev gdal-bin python3-gdal libgeos-dev libproj-dev proj-data proj-bin libgeographiclib-dev

@@ -18,8 +18,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash packaging/install-deps.sh
 build=${GROUNDPLAN_SANITIZE_BUILD_DIR:-build-asan}
+source packaging/ccache-flags.sh
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DGROUNDPLAN_SANITIZE=ON -DGROUNDPLAN_BUILD_BENCH=OFF \
-  -DGROUNDPLAN_CUDA=OFF >/dev/null
+  -DGROUNDPLAN_CUDA=OFF "${ccache_flags[@]}" >/dev/null
 cmake --build "$build" -j"$(nproc)"
 
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

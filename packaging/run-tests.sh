@@ -4,7 +4,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash packaging/install-deps.sh
 build=${GROUNDPLAN_BUILD_DIR:-build}
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DGROUNDPLAN_CUDA=${GROUNDPLAN_CUDA:-AUTO} >/dev/null
+source packaging/ccache-flags.sh
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DGROUNDPLAN_CUDA=${GROUNDPLAN_CUDA:-AUTO} "${ccache_flags[@]}" >/dev/null
 cmake --build "$build" -j"$(nproc)"
 # Samples that may not be redistributed (tests/data/README.md): tests labelled thirdparty-data use them where found
 # and are skipped, one line each, where not.

@@ -413,7 +413,7 @@ Result run_cancellable(Work&& work, const py::object& callback) {
   double last_sent = -1;
   bool refused = false;  // the callback returned False
   auto forward = [&] {  // GIL held
-    if (callback.is_none() || py_error) return;
+    if (callback.is_none() || py_error || refused) return;  // never called again once it said stop
     double f;
     std::string msg;
     {

@@ -32,7 +32,7 @@ def test_cli_file_sequence_and_folder_give_the_same_plans(tmp_path):
     folder = tmp_path / "tiles"
     folder.mkdir()
     shutil.copy(BAG_SEQ, folder / "t.city.jsonl")
-    (folder / "tileset.json").write_text('{"asset": {"version": "1.0"}}')
+    (folder / "metadata.json").write_text('{"asset": {"version": "1.0"}}')
     run([BIN, "-f", "GPKG", tmp_path / "f.gpkg", folder, "ground_plans", "problems"])
     assert _plans(tmp_path / "f.gpkg") == _plans(outs[0])
     assert layer_rows(tmp_path / "f.gpkg", "problems") == []

@@ -48,7 +48,7 @@ struct FootprintResult {
                                  // (decompose), "EMPTY_MESH"
   std::string reason;            // when !ok: one sentence for the Problem
   std::string note;              // when ok but found by a last resort (the shadow): why the earlier methods failed
-  /// When ok by surface decomposition: the footprint checked against the building's lowest horizontal faces;
+  /// When ok by surface decomposition or a solid's bottom: the footprint checked against the building's lowest horizontal faces;
   /// non-empty when it leaves out ground the building stands on (FOOTPRINT_MISSES_GROUND), with the areas.
   std::string misses_ground;
 };

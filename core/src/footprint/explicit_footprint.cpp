@@ -212,6 +212,7 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
     std::uint32_t face;
     double nz;        // unit normal's z as written
     double zlo, zhi;  // outer ring's z range
+    double plan_m2;   // outer ring's area in plan
   };
   std::vector<Cand> horizontal;
   for (std::uint32_t i = 0; i < mesh.faces.size(); ++i) {
@@ -232,7 +233,7 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
       zhi = std::max(zhi, z);
     }
     zmin = std::min(zmin, zlo);
-    if (std::fabs(n.z) >= cos_tol * len) horizontal.push_back(Cand{i, n.z / len, zlo, zhi});
+    if (std::fabs(n.z) >= cos_tol * len) horizontal.push_back(Cand{i, n.z / len, zlo, zhi, std::fabs(n.z) / 2});
   }
   // Orientation: outward when the signed volume is positive. Files are not consistent (inward
   // shells, bags of polygons); a volume that is tiny against area^1.5 says nothing.
@@ -240,18 +241,32 @@ FootprintResult make_footprint(const Mesh& mesh, const FootprintParams& params) 
   const int outward = std::fabs(volume) > 1e-3 * scale ? (volume > 0 ? 1 : -1) : 0;
 
   std::vector<const Cand*> bottom, bottom_down;
+  double down_m2 = 0, up_m2 = 0;
   for (const Cand& c : horizontal) {
     if (c.zhi > zmin + params.level_tolerance_m) continue;
     bottom.push_back(&c);
-    if (outward != 0 && c.nz * outward < 0) bottom_down.push_back(&c);
+    if (outward != 0 && c.nz * outward < 0) {
+      bottom_down.push_back(&c);
+      down_m2 += c.plan_m2;
+    } else {
+      up_m2 += c.plan_m2;
+    }
   }
-  // Down-facing faces at the lowest level are the bottom. If orientation says none faces down
-  // (an open bag whose volume sign means nothing), faces at the lowest level still are.
-  const auto& chosen = bottom_down.empty() ? bottom : bottom_down;
+  // Down-facing faces at the lowest level are the bottom (an up-facing one there is the top of something
+  // low: a slab, a plinth, a floor outside the solid). In a closed solid whose faces all turn the same way,
+  // every up-facing face at the lowest level has down-facing ones below it, so the down-facing ones cover
+  // at least as much plan as the up-facing ones. Where they cover less, the faces' turns say nothing: the
+  // bottom is turned inward unlike the walls (a bag of polygons, an inconsistent export), or its turn is
+  // noise (quantised positions flip slivers of a few square centimetres over, and taking those alone lost a
+  // whole building's ground). Then, as when none faces down, every face at the lowest level is the bottom.
+  const auto& chosen = down_m2 >= up_m2 && !bottom_down.empty() ? bottom_down : bottom;
   for (const Cand* c : chosen) add_face_2d(mesh, mesh.faces[c->face], params.min_face_area_m2, fp.polygons);
   if (!fp.polygons.empty()) {
     res.ok = true;
     res.method = FootprintMethod::SolidBottom;
+    // Chosen among the lowest horizontal faces by their turn: those left out must lie over the chosen ones.
+    const footprint::GroundCheck g = footprint::check_ground(mesh, fp.polygons, params);
+    if (g.misses_ground()) res.misses_ground = g.reason();
     return res;
   }
 

@@ -22,6 +22,7 @@
 #include <atomic>
 #include <charconv>
 #include <chrono>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <memory>
@@ -82,6 +83,18 @@ std::vector<std::string> input_list(const std::string& source) {
   return inputs;
 }
 
+namespace {
+
+/// A file that is a tile's content in a 3D Tiles folder (read through its tileset.json, never on its own there).
+bool is_tile_content_name(const std::string& name) {
+  const std::string l = lower(name);
+  for (const char* ext : {".glb", ".gltf", ".b3dm", ".i3dm", ".cmpt", ".pnts"})
+    if (l.size() > std::strlen(ext) && l.compare(l.size() - std::strlen(ext), std::string::npos, ext) == 0) return true;
+  return false;
+}
+
+}  // namespace
+
 /// Files named by the inputs: a file as is, a folder as its input files (CityGML, KML/KMZ, glTF, CityJSON;
 /// not .dae, which belong to a .kml beside them; Shapefile, GeoPackage, FlatGeobuf, GeoJSON) sorted by name,
 /// a .zip as its city files.
@@ -90,17 +103,22 @@ std::vector<std::string> detail::expand_inputs(const std::vector<std::string>& i
   for (const std::string& in : inputs) {
     std::error_code ec;
     if (fs::is_directory(in, ec)) {
-      // A 3D Tiles folder: its tileset.json is the entry point (its tiles are read through it, not one by one).
-      if (fs::is_regular_file(fs::path(in) / "tileset.json", ec)) {
-        files.push_back((fs::path(in) / "tileset.json").string());
+      // A 3D Tiles folder: its tileset.json is the entry point, and its tiles (glTF, b3dm, i3dm, cmpt) are read through
+      // it, not one by one; city files of other formats beside it are inputs of their own.
+      const bool tileset = fs::is_regular_file(fs::path(in) / "tileset.json", ec);
+      std::vector<std::string> found;
+      if (tileset) files.push_back((fs::path(in) / "tileset.json").string());
+      for (const auto& e : fs::directory_iterator(in, ec)) {
+        const std::string name = e.path().filename().string();
+        if (!e.is_regular_file() || !(is_input_name(name) || is_ogr_input_name(name))) continue;
+        if (tileset && (name == "tileset.json" || is_tile_content_name(name))) continue;
+        found.push_back(e.path().string());
+      }
+      std::sort(found.begin(), found.end());
+      if (tileset) {
+        files.insert(files.end(), found.begin(), found.end());
         continue;
       }
-      std::vector<std::string> found;
-      for (const auto& e : fs::directory_iterator(in, ec))
-        if (e.is_regular_file() && (is_input_name(e.path().filename().string()) ||
-                                    is_ogr_input_name(e.path().filename().string())))
-          found.push_back(e.path().string());
-      std::sort(found.begin(), found.end());
       if (found.empty()) {
         std::string why = in + ": folder holds no input file (" + input_name_patterns() +
                           ", *.shp, *.gpkg, *.fgb, *.geojson)";

@@ -28,6 +28,7 @@ using tiles3d::Mat4;
 
 constexpr double kMaxTranslation = 1e8;  // metres: ~15 Earth radii; anything farther places nothing on the Earth
 constexpr double kMaxLinear = 1e6;       // a rotation-scale entry: a millionfold scale is no placement
+constexpr std::uint32_t kExternalRoot = 1u << 31;  // a TilePath step into an external tileset (+ the content's index)
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -65,20 +66,23 @@ class Walker {
     const nlohmann::json j = load_tileset(path);
     if (j.contains("asset") && j["asset"].is_object() && j["asset"].contains("version") && j["asset"]["version"].is_string())
       info_.version = j["asset"]["version"].get<std::string>();
-    tileset(path, j, detail::kIdentity, "REPLACE", 0);
+    tileset(path, j, detail::kIdentity, "REPLACE", 0, {});
   }
 
   /// One content file given alone: the content of a tile without transform. Throws when it cannot be read.
   void content_alone(const std::string& path) {
-    Job job{path, fs::path(path).filename().string(), detail::kIdentity};
+    Job job{path, fs::path(path).filename().string(), detail::kIdentity, {}};
     Done done = read_job(job);
     if (!done.failure.empty()) throw InputError(done.failure);
     deliver(done);
   }
 
   /// The contents the walk chose, read side by side (each read, parsed and decoded on its own thread),
-  /// delivered in tile order on this thread: at most two contents a thread in flight.
+  /// delivered on this thread, the deepest tiles first (so that a finer level of a building comes before its
+  /// coarser copies in ancestor tiles: deliver()), in tile order within a depth: at most two contents a
+  /// thread in flight.
   void read_contents(const std::function<void(std::size_t done, std::size_t total)>& progress) {
+    std::stable_sort(jobs_.begin(), jobs_.end(), [](const Job& a, const Job& b) { return a.path.size() > b.path.size(); });
     const std::size_t n = jobs_.size();
     std::size_t next = 0, delivered = 0;
     const auto tokens = static_cast<std::size_t>(2 * std::max(1, tbb::this_task_arena::max_concurrency()));
@@ -103,13 +107,22 @@ class Walker {
   std::size_t contents() const { return jobs_.size(); }
 
  private:
+  /// Where a tile sits in the tree: the index of each child taken from the root (an external tileset's root
+  /// and an implicit tile's children are children too). A tile is an ancestor of another when its path is a
+  /// proper prefix of the other's.
+  using TilePath = std::vector<std::uint32_t>;
+  static bool is_ancestor(const TilePath& a, const TilePath& b) {
+    return a.size() < b.size() && std::equal(a.begin(), a.end(), b.begin());
+  }
   struct Job {
     std::string file, label;
     Mat4 transform;
+    TilePath path;
   };
   /// A content read: its meshes (placed in ECEF or local, not yet in the working CRS) and problems.
   struct Done {
     std::string file;
+    TilePath path;
     std::vector<std::pair<Mesh, GltfFrame>> meshes;
     std::vector<Problem> problems;
     Tiles3dInfo info;  // contents, georeference, by_feature of this content
@@ -119,6 +132,7 @@ class Walker {
   Done read_job(const Job& job) const {
     Done d;
     d.file = job.file;
+    d.path = job.path;
     try {
       xml::ByteBudget budget;
       budget.max_entry_bytes = budget.max_total_bytes = opt_.gltf.max_bytes;
@@ -137,16 +151,31 @@ class Walker {
     if (!d.info.georeference.empty()) info_.georeference = d.info.georeference;
     info_.by_feature = info_.by_feature || d.info.by_feature;
     for (auto& [mesh, frame] : d.meshes) {
-      // A building id of an earlier content: the same building twice (in two levels of an ADD tileset, or cut
-      // between tiles). Both are read, and said, as CityGML's repeated gml:id is.
-      auto [at, fresh] = delivered_.emplace(mesh.source_id, d.file);
-      if (!fresh && at->second != d.file)
+      // A building id that an earlier content gave already. Contents come deepest first (read_contents), so
+      // when that content is in a tile below this one, it holds the same building at a finer level (the
+      // children of an ADD tile, or a tile below the level the walk stopped at for another branch): the finer
+      // copy is the one read, as "the finest level" says, and this coarser one is left out, said in a NOTE.
+      // Anywhere else (two contents of one tile, a building cut between neighbouring tiles) the two copies
+      // may be different pieces of the building: both are read, and said, as CityGML's repeated gml:id is.
+      std::vector<Delivered>& earlier = delivered_[mesh.source_id];
+      const auto finer = std::find_if(earlier.begin(), earlier.end(), [&](const Delivered& e) { return is_ancestor(d.path, e.path); });
+      if (finer != earlier.end()) {
+        problems_.push_back(Problem{mesh.source_id, d.file, "read", "NOTE",
+                                    "building id \"" + mesh.source_id + "\" is also in " + finer->file +
+                                        ", a tile below this one (a finer level of detail): that copy is read, this "
+                                        "coarser one is left out"});
+        ++info_.coarser_copies_left_out;
+        continue;
+      }
+      if (!earlier.empty() && earlier.front().delivery != deliveries_)  // (one content may repeat an id: glTF nodes)
         problems_.push_back(Problem{mesh.source_id, d.file, "read", "DUPLICATE_ID",
-                                    "building id \"" + mesh.source_id + "\" is also in " + at->second +
-                                        " (the same building at two levels of an ADD tileset, or cut between tiles): both are read"});
+                                    "building id \"" + mesh.source_id + "\" is also in " + earlier.front().file +
+                                        " (two contents of one tile, or a building cut between tiles): both are read"});
+      if (earlier.empty() || earlier.back().delivery != deliveries_) earlier.push_back(Delivered{d.file, d.path, deliveries_});
       cb_(std::move(mesh), frame);
     }
     d.meshes.clear();
+    ++deliveries_;
   }
 
   void problem(const std::string& file, const std::string& code, const std::string& reason) {
@@ -168,14 +197,15 @@ class Walker {
     return j;
   }
 
-  void tileset(const std::string& path, const nlohmann::json& j, const Mat4& parent, const std::string& refine, int depth) {
+  void tileset(const std::string& path, const nlohmann::json& j, const Mat4& parent, const std::string& refine, int depth,
+               const TilePath& at) {
     if (j.contains("extensionsRequired") && j["extensionsRequired"].is_array())
       for (const auto& e : j["extensionsRequired"])
         if (e.is_string() && e.get<std::string>() != "3DTILES_content_gltf")
           throw InputError(path + ": requires the 3D Tiles extension " + e.get<std::string>() +
                            ", which groundplan does not read");
     stack_.push_back(key(path));
-    tile(path, j["root"], parent, refine, depth);
+    tile(path, j["root"], parent, refine, depth, at);
     stack_.pop_back();
   }
 
@@ -256,7 +286,7 @@ class Walker {
   }
 
   void tile(const std::string& tileset_path, const nlohmann::json& t, const Mat4& parent, const std::string& parent_refine,
-            int depth) {
+            int depth, const TilePath& at) {
     if (!t.is_object()) return problem(tileset_path, "BAD_TILE", "a tile is not a JSON object: skipped");
     if (depth > opt_.max_depth)
       return problem(tileset_path, "TILE_TOO_DEEP",
@@ -279,7 +309,7 @@ class Walker {
       const std::string r = lower(t["refine"].get<std::string>());
       if (r == "add" || r == "replace") refine = r == "add" ? "ADD" : "REPLACE";
     }
-    if (t.contains("implicitTiling")) return implicit(tileset_path, t, world, refine);
+    if (t.contains("implicitTiling")) return implicit(tileset_path, t, world, refine, at);
     const bool has_children = t.contains("children") && t["children"].is_array() && !t["children"].empty();
     const double error = t.contains("geometricError") && t["geometricError"].is_number() ? t["geometricError"].get<double>() : 0;
     const bool stop = !has_children || (opt_.geometric_error >= 0 && error <= opt_.geometric_error);
@@ -289,7 +319,8 @@ class Walker {
     if (t.contains("contents") && t["contents"].is_array())
       for (const auto& c : t["contents"])
         if (c.is_object()) contents.push_back(&c);
-    for (const nlohmann::json* c : contents) {
+    for (std::uint32_t k = 0; k < contents.size(); ++k) {
+      const nlohmann::json* c = contents[k];
       const nlohmann::json* u = c->contains("uri") ? &(*c)["uri"] : c->contains("url") ? &(*c)["url"] : nullptr;
       if (!u || !u->is_string()) {
         problem(tileset_path, "BAD_TILE", "a tile content has no uri: skipped");
@@ -299,21 +330,29 @@ class Walker {
       const std::string file = resolve(tileset_path, uri);
       if (file.empty()) continue;
       if (lower(fs::path(file).extension().string()) == ".json") {
-        external(tileset_path, file, world, refine, depth);
+        TilePath below = at;  // the external tileset's root: a child of this tile, after its children
+        below.push_back(kExternalRoot + k);
+        external(tileset_path, file, world, refine, depth, below);
         continue;
       }
       if (!take) {
         ++info_.skipped_by_level;
         continue;
       }
-      jobs_.push_back(Job{file, uri, world});
+      jobs_.push_back(Job{file, uri, world, at});
     }
     if (stop) return;
-    for (const auto& child : t["children"]) tile(tileset_path, child, world, refine, depth + 1);
+    TilePath below = at;
+    below.push_back(0);
+    for (const auto& child : t["children"]) {
+      tile(tileset_path, child, world, refine, depth + 1, below);
+      ++below.back();
+    }
   }
 
   /// A tile with implicit tiling: its available descendants (subtree files) chosen as explicit tiles are.
-  void implicit(const std::string& tileset_path, const nlohmann::json& t, const Mat4& world, const std::string& refine) {
+  void implicit(const std::string& tileset_path, const nlohmann::json& t, const Mat4& world, const std::string& refine,
+                const TilePath& at) {
     tiles3d::ImplicitTiling tiling;
     const std::string why = tiles3d::parse_implicit(t, tiling);
     if (!why.empty()) return problem(tileset_path, "BAD_TILE", "a tile with implicit tiling is skipped: " + why);
@@ -337,7 +376,7 @@ class Walker {
         if (stop || refine == "ADD") {
           const std::string uri = tiles3d::expand(tiling.content, it);
           const std::string file = resolve(tileset_path, uri);
-          if (!file.empty()) jobs_.push_back(Job{file, uri, world});
+          if (!file.empty()) jobs_.push_back(Job{file, uri, world, implicit_path(at, it)});
         } else {
           ++info_.skipped_by_level;
         }
@@ -349,14 +388,23 @@ class Walker {
     for (const auto& [file, what] : failed) problem(file, "UNREADABLE_SUBTREE", what + ": the tiles below it are left out");
   }
 
-  void external(const std::string& from, const std::string& file, const Mat4& world, const std::string& refine, int depth) {
+  /// An implicit tile's path: the explicit tile's, then the child taken at each level (the bits of x, y, z).
+  static TilePath implicit_path(const TilePath& at, const tiles3d::ImplicitTile& it) {
+    TilePath p = at;
+    for (int l = it.level - 1; l >= 0; --l)
+      p.push_back(static_cast<std::uint32_t>(((it.x >> l) & 1u) | (((it.y >> l) & 1u) << 1) | (((it.z >> l) & 1u) << 2)));
+    return p;
+  }
+
+  void external(const std::string& from, const std::string& file, const Mat4& world, const std::string& refine, int depth,
+                const TilePath& at) {
     const std::string k = key(file);
     if (std::find(stack_.begin(), stack_.end(), k) != stack_.end())
       return problem(from, "TILESET_CYCLE", "external tileset " + file + " includes itself (through " + from + "): not followed");
     try {
       const nlohmann::json j = load_tileset(file);
       ++info_.external_tilesets;
-      tileset(file, j, world, refine, depth + 1);
+      tileset(file, j, world, refine, depth + 1, at);
     } catch (const InputError& e) {
       problem(file, "UNREADABLE_TILE", e.what());
     }
@@ -370,7 +418,13 @@ class Walker {
   bool vsi_ = false;
   std::vector<std::string> stack_;  // tilesets being read, root first
   std::vector<Job> jobs_;           // the contents chosen, in tile order
-  std::unordered_map<std::string, std::string> delivered_;  // building id -> the content that gave it first
+  struct Delivered {
+    std::string file;
+    TilePath path;
+    std::size_t delivery;  // which content delivered (deliveries_ then)
+  };
+  std::size_t deliveries_ = 0;
+  std::unordered_map<std::string, std::vector<Delivered>> delivered_;  // building id -> the contents that gave it
 };
 
 }  // namespace

@@ -84,6 +84,41 @@ TEST(ExplicitFootprint, OverhangUnderSideIsNotFootprint) {
   EXPECT_NEAR(total_area(r.footprint), 100, 1e-9);
 }
 
+TEST(ExplicitFootprint, SliversFlippedByQuantizationAreNotTheWholeBottom) {
+  // Walls and roof turned outward, the bottom turned inward (facing up, as the lowest faces are in a
+  // bag of triangles exported so), and three slivers of the bottom's triangulation, a few cm² each,
+  // flipped over by quantized positions: they alone face down. The bottom is the whole 12 x 10 m.
+  Mesh m;
+  m.source_id = "flipped";
+  add_box(m, 0, 0, 0, 12, 10, 10);
+  std::reverse(m.indices.begin() + m.ring_offsets[0] + 1, m.indices.begin() + m.ring_offsets[1]);  // bottom up
+  for (double x : {2.0, 5.0, 8.0})  // down-facing (clockwise in plan), 1 m long and 4 cm wide: 0.02 m²
+    m.add_face({{{x, 3, 0.01}, {x + 0.5, 3.04, 0.01}, {x + 1, 3, 0.01}}}, SurfaceKind::Unknown, 1);
+  FootprintResult r = make_footprint(m);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.method, FootprintMethod::SolidBottom);
+  EXPECT_GE(total_area(r.footprint), 120 - 1e-9);
+  EXPECT_TRUE(r.misses_ground.empty()) << r.misses_ground;
+}
+
+TEST(ExplicitFootprint, ASolidBottomLeavingOutLowestFacesIsSaid) {
+  // A closed box turned outward (its bottom faces down) and, beside it, an up-facing face at ground level
+  // (a terrace's top drawn with the building): the bottom is the box's (down-facing, as much plan as the
+  // up-facing face), and the ground left out under that lowest face is said with its area.
+  Mesh m;
+  add_box(m, 0, 0, 0, 10, 10, 10);
+  m.add_face({{{10, 0, 0.2}, {14, 0, 0.2}, {14, 10, 0.2}, {10, 10, 0.2}}}, SurfaceKind::Unknown, 1);  // up, 40 m²
+  FootprintResult r = make_footprint(m);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.method, FootprintMethod::SolidBottom);
+  EXPECT_NEAR(total_area(r.footprint), 100, 1e-9);
+  EXPECT_NE(r.misses_ground.find("leaves out 40.0 m2"), std::string::npos) << r.misses_ground;
+  // Without it, nothing is said.
+  Mesh box;
+  add_box(box, 0, 0, 0, 10, 10, 10);
+  EXPECT_TRUE(make_footprint(box).misses_ground.empty());
+}
+
 TEST(ExplicitFootprint, SeveralGroundSurfacesWithHolesWinOverEverythingElse) {
   Mesh m;
   add_box(m, 0, 0, 0, 10, 10, 10);

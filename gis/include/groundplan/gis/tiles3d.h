@@ -46,6 +46,7 @@ struct Tiles3dInfo {
   std::size_t tiles = 0;        // tiles visited
   std::size_t contents = 0;     // contents read (a cmpt counts once per inner tile)
   std::size_t skipped_by_level = 0;  // contents left out by the level-of-detail choice
+  std::size_t coarser_copies_left_out = 0;  // buildings left out because a tile below gave them (a finer level)
   std::size_t external_tilesets = 0;
   std::string georeference;     // what the contents' glTF said last (GltfInfo::georeference)
   bool by_feature = false;      // some content split its buildings by feature id
@@ -53,8 +54,9 @@ struct Tiles3dInfo {
 
 /// Reads a tileset.json, or one content file (.b3dm, .i3dm, .cmpt placed as the content of a tile with no
 /// transform). Meshes go to `on_mesh` as the glTF reader gives them (GltfFrame::Ecef when placed on the
-/// Earth), on the calling thread, tile after tile in the tree's order: the tree is walked first (its
-/// JSON only), then the contents chosen are read, parsed and decoded side by side on the current TBB
+/// Earth), on the calling thread, content after content, the deepest tiles first (a building id that a tile
+/// and a tile below it both hold is read once, from the tile below; the coarser copy is a NOTE problem).
+/// The tree is walked first (its JSON only), then the contents chosen are read, parsed and decoded side by side on the current TBB
 /// arena, at most two a thread in flight. `progress` (may be empty) is told after each content.
 /// Throws InputError naming the file when the root cannot be read at all.
 void read_3d_tiles(const std::string& path, const Tiles3dOptions& options, const GltfMeshCallback& on_mesh,
