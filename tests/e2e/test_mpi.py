@@ -5,11 +5,13 @@ and problems must be those of the one-process run (as test_tiles.py compares the
 N; no plan split at a tile edge (no two plans share more than corner points), every plan GEOS-valid, nothing lost (buildings = member rows
 + dropped). A bad tile is a problem and the run completes; a rank that dies ends the run with a message and no
 dataset. Skipped when the build has no MPI or mpirun is missing."""
+import atexit
 import json
 import math
 import os
 import shutil
 import subprocess
+import tempfile
 
 import pytest
 from osgeo import ogr
@@ -30,9 +32,17 @@ def mpi_build():
 pytestmark = pytest.mark.skipif(not mpi_build(), reason="no MPI in this build, or no mpirun")
 
 
+# Open MPI keeps each job's session folder in <base>/ompi.<host>.<uid>/, and an mpirun that ends removes that folder
+# when it is empty. Two test processes side by side (e2e_mpi and e2e_postgis under ctest -j2) could race there: a clean
+# clone's CI once failed with "A call to mkdir was unable to create the desired directory: /tmp/ompi.vm.0/pid.N".
+# A base folder of this process's own keeps them apart.
+_OMPI_BASE = tempfile.mkdtemp(prefix="groundplan-ompi-")
+atexit.register(shutil.rmtree, _OMPI_BASE, True)
+
+
 def mpirun(n):
     # As root in CI and containers; more ranks than cores on a small machine.
-    return ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(n)]
+    return ["mpirun", "--allow-run-as-root", "--oversubscribe", "--mca", "orte_tmpdir_base", _OMPI_BASE, "-np", str(n)]
 
 
 def check_plans(result, stats, ranks, tiles):
