@@ -2,6 +2,8 @@
 // The footprint against the building's lowest horizontal faces (see ground_check.h).
 #include "footprint/ground_check.h"
 
+#include <groundplan/ring_normal.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -103,15 +105,8 @@ GroundCheck check_ground(const Mesh& mesh, const std::vector<Polygon>& footprint
     if (!low) continue;
     // Horizontal: Newell's normal about the first corner.
     const Point3 o = mesh.vertices[mesh.indices[a]];
-    double nx = 0, ny = 0, nz = 0;
-    for (std::uint32_t k = a; k < b; ++k) {
-      const Point3& p = mesh.vertices[mesh.indices[k]];
-      const Point3& q = mesh.vertices[mesh.indices[k + 1 < b ? k + 1 : a]];
-      const double px = p.x - o.x, py = p.y - o.y, pz = p.z - o.z, qx = q.x - o.x, qy = q.y - o.y, qz = q.z - o.z;
-      nx += (py - qy) * (pz + qz);
-      ny += (pz - qz) * (px + qx);
-      nz += (px - qx) * (py + qy);
-    }
+    const Point3 n = ring_normal(mesh, f.first_ring);
+    const double nx = n.x, ny = n.y, nz = n.z;
     const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
     if (!(len > 0) || std::fabs(nz) < cos_tol * len) continue;
     const double sign = nz > 0 ? 1 : -1;  // the outer ring's turn in plan

@@ -3,6 +3,7 @@
 // reading (every format it knows); this file only decides what a feature is to the ground plans.
 #include <groundplan/error.h>
 #include <groundplan/gis/ogr_input.h>
+#include <groundplan/ring_normal.h>
 
 #include "coordinate_limit.h"
 #include "files_read.h"
@@ -145,16 +146,8 @@ void collect(const OGRGeometry* g, Faces& out, int depth) {
 bool horizontal(const Mesh& m, std::uint32_t r) {
   const std::uint32_t a = m.ring_offsets[r], b = m.ring_offsets[r + 1];
   if (b - a < 3) return true;
-  const Point3 o = m.vertices[m.indices[a]];
-  double nx = 0, ny = 0, nz = 0;
-  for (std::uint32_t k = a; k < b; ++k) {
-    const Point3& p = m.vertices[m.indices[k]];
-    const Point3& q = m.vertices[m.indices[k + 1 < b ? k + 1 : a]];
-    const double px = p.x - o.x, py = p.y - o.y, pz = p.z - o.z, qx = q.x - o.x, qy = q.y - o.y, qz = q.z - o.z;
-    nx += (py - qy) * (pz + qz);
-    ny += (pz - qz) * (px + qx);
-    nz += (px - qx) * (py + qy);
-  }
+  const Point3 n = ring_normal(m, r);
+  const double nx = n.x, ny = n.y, nz = n.z;
   const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
   return len == 0 || std::fabs(nz) >= std::cos(kHorizontalToleranceDeg * kPi / 180.0) * len;
 }
